@@ -1,0 +1,192 @@
+/**
+ * @file fesd_integrator.h
+ * @brief The FESD integrator (and the standard time-stepping method) for
+ *        piecewise-smooth ODEs in Filippov's sense (src/fesd).
+ *
+ * Model. x' = sum_k F^k(x,u) theta^k with one Stewart DCS per subsystem k
+ * (paper Sec. 2.2 and 2.3): F^k = [f_{k,0} ... f_{k,nf_k-1}] are the mode fields,
+ * regions are given by switching functions c^k(x,u) in R^{nc_k} with a sign matrix
+ * S^k (Stewart indicators g^k = -S^k c^k, Proposition 1) or directly by indicators
+ * g^k(x,u) in R^{nf_k}. Mode i of subsystem k is active in the region where row i of
+ * S^k matches the signs of c^k: with the default full sign matrix, row i has entry
+ * S[i][j] = -1 if bit (nc-1-j) of i is set, else +1 (row 0 = all c_j > 0, last row =
+ * all c_j < 0).
+ *
+ * Units: t, T, h in the model's time unit; tolerances absolute in the units of
+ * the residual rows (states, indicator values).
+ */
+#ifndef FESD_INTEGRATOR_H
+#define FESD_INTEGRATOR_H
+
+#include "fesd_ncp.h"
+#include "fesd_rk.h"
+#include "fesd_status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---- model callbacks: return 0 on success, nonzero on failure (the step fails with
+ *      FESD_ERR_CALLBACK naming the callback and the time). ---- */
+
+/** Mode field f_{sys,mode}(x,u): write nx values to f. */
+typedef int (*fesd_field_fn)(int sys, int mode, const double *x, const double *u, double *f,
+                             void *user);
+/** Jacobians of f_{sys,mode}: dfdx (nx x nx, column-major), dfdu (nx x nu, column-major;
+ *  NULL when nu == 0). */
+typedef int (*fesd_field_jac_fn)(int sys, int mode, const double *x, const double *u,
+                                 double *dfdx, double *dfdu, void *user);
+/** Switching functions c^sys(x,u) (n_switch[sys] values), or indicators g^sys
+ *  (n_modes[sys] values) when n_switch[sys] == 0. */
+typedef int (*fesd_switch_fn)(int sys, const double *x, const double *u, double *c, void *user);
+/** Jacobians of the switch callback: dcdx (rows x nx), dcdu (rows x nu; NULL when nu == 0). */
+typedef int (*fesd_switch_jac_fn)(int sys, const double *x, const double *u, double *dcdx,
+                                  double *dcdu, void *user);
+
+/** Model description. Arrays are copied by fesd_create(). */
+typedef struct {
+  int nx;                 /**< states (>= 1) */
+  int nu;                 /**< controls/parameters held constant over a step (>= 0) */
+  int nsys;               /**< independent subsystems (>= 1) */
+  const int *n_modes;     /**< [nsys] modes per subsystem (>= 2) */
+  const int *n_switch;    /**< [nsys] switching functions per subsystem; 0 = indicators given
+                               directly; NULL = all 0 */
+  const signed char *const *sign; /**< [nsys] sign matrices (n_modes x n_switch, row-major,
+                               entries +-1, no repeated rows); NULL or a NULL entry = full
+                               enumeration (needs n_modes == 2^n_switch) */
+  fesd_field_fn field;          /**< required */
+  fesd_field_jac_fn field_jac;  /**< optional: NULL = central finite differences */
+  fesd_switch_fn sw;            /**< required */
+  fesd_switch_jac_fn sw_jac;    /**< optional: NULL = central finite differences */
+  void *user;                   /**< passed to every callback */
+} fesd_model;
+
+typedef enum {
+  FESD_METHOD_FESD = 0,    /**< finite elements with switch detection (variable h_n) */
+  FESD_METHOD_STANDARD = 1 /**< standard time-stepping (h_n = T/N_FE fixed) */
+} fesd_method;
+
+/** Integrator settings; fesd_settings_default() fills the documented defaults. */
+typedef struct {
+  fesd_method method;       /**< default FESD */
+  fesd_rk_family family;    /**< default Radau IIA */
+  int stages;               /**< s, default 2 */
+  int n_fe;                 /**< finite elements per step, default 2 (FESD needs >= 2) */
+  double newton_tol;        /**< ||F||_inf tolerance of every step solve (default 1e-12) */
+  int max_iter_first;       /**< iterations of the first (equal-h) attempt (default 12) */
+  int max_iter;             /**< iterations of the switch solves (default 40) */
+  double cc_tol;            /**< tolerance on every cross-complementarity product
+                                 theta_{n,m,i} lambda_{n,m',i} (units of g; default 1e-9) */
+  double active_tol;        /**< theta_i > active_tol marks mode i active (default 1e-6) */
+  int exit_rows;            /**< pin sliding exits (beyond the paper, docs/sliding_exit.md);
+                                 default 1; 0 = the paper's formulation */
+  int max_splits;           /**< recursive halvings of a failed step (default 6, at most 12) */
+  int sensitivities;        /**< propagate dx/dx0 and dx/du (default 0) */
+  fesd_ncp_settings ncp;    /**< linear algebra/line-search settings of the solver */
+} fesd_settings;
+
+typedef enum {
+  FESD_EVENT_CROSSING = 0,       /**< active set replaced (transversal crossing) */
+  FESD_EVENT_SLIDING_ENTRY = 1,  /**< active set grows (reaching a sliding surface) */
+  FESD_EVENT_SLIDING_EXIT = 2    /**< active set shrinks (leaving a sliding surface) */
+} fesd_event_kind;
+
+/** A detected switch at an element boundary. */
+typedef struct {
+  double t;              /**< time of the element boundary carrying the switch */
+  int sys;               /**< subsystem */
+  fesd_event_kind kind;
+  unsigned before;       /**< active modes before (bit i = mode i; modes >= 32 not shown) */
+  unsigned after;        /**< active modes after */
+} fesd_event;
+
+/** Statistics of one fesd_step() (accumulated over sub-steps when it splits). */
+typedef struct {
+  int status;           /**< FESD_OK or a negative fesd_status */
+  int newton_iter;      /**< Newton iterations of all solves of the step */
+  int factorizations;
+  int solves;           /**< calls of the NCP solver */
+  int homotopy_stages;
+  int splits;           /**< sub-steps added by recovery (0 = none) */
+  int switch_step;      /**< 1 if the accepted solution needed a switch solve */
+  double residual;      /**< final ||F||_inf of the accepted system */
+  double cc_max;        /**< max cross-complementarity product of the accepted solution */
+  double time;          /**< wall-clock seconds of the step */
+  const char *failed_callback; /**< on FESD_ERR_CALLBACK/NONFINITE: "field", "switch", ... */
+  double failed_time;   /**< on failure: start time of the failed step */
+} fesd_step_info;
+
+typedef struct fesd_integrator fesd_integrator; /**< opaque */
+
+/** @brief Defaults: FESD, Radau IIA s = 2, N_FE = 2, tolerances above. */
+FESD_API int fesd_settings_default(fesd_settings *s);
+
+/**
+ * @brief Validate the model and settings, build sign matrices and the step system,
+ *        allocate every workspace (the only allocating call besides fesd_trajectory_create).
+ * @return FESD_OK, FESD_ERR_NULL, FESD_ERR_MODEL, FESD_ERR_SIGN_MATRIX, FESD_ERR_DIMENSION,
+ *         FESD_ERR_UNSUPPORTED_TABLEAU, FESD_ERR_INVALID_ARG, FESD_ERR_NOMEM.
+ */
+FESD_API int fesd_create(fesd_integrator **it, const fesd_model *model,
+                         const fesd_settings *settings);
+/** @brief Free and set *it = NULL (accepts NULL). */
+FESD_API void fesd_free(fesd_integrator **it);
+
+/** @brief Set the current time and state; resets sensitivities to identity/zero and
+ *         computes lambda_{0,0} = g(x0) - min g(x0). u is used to evaluate g. */
+FESD_API int fesd_set_state(fesd_integrator *it, double t0, const double *x0, const double *u);
+
+/**
+ * @brief Advance one integration step of length T with control u (N_FE elements),
+ *        warm started from the previous step. On failure the state is unchanged
+ *        (the caller may retry with other settings).
+ */
+FESD_API int fesd_step(fesd_integrator *it, const double *u, double T, fesd_step_info *info);
+
+/** @brief Current time and state (x: nx values; either pointer may be NULL). */
+FESD_API int fesd_get_state(const fesd_integrator *it, double *t, double *x);
+
+/** @brief Sensitivities of the current state w.r.t. the state given to fesd_set_state
+ *         (Sx: nx x nx) and w.r.t. u (Su: nx x nu, u constant since set_state), column-major.
+ *         FESD_ERR_NOT_READY if settings.sensitivities was 0. Either pointer may be NULL. */
+FESD_API int fesd_get_sensitivities(const fesd_integrator *it, double *Sx, double *Su);
+
+/** @brief Events detected in the last fesd_step (pointer valid until the next step). */
+FESD_API int fesd_last_events(const fesd_integrator *it, const fesd_event **events, int *count);
+
+/** Per-element data of the last accepted step. */
+typedef struct {
+  int n_elements;         /**< elements of the accepted step (N_FE times the sub-steps) */
+  const double *h;        /**< element lengths */
+  const double *t;        /**< element start times (n_elements + 1 entries, last = step end) */
+  const double *x;        /**< boundary states, (n_elements + 1) x nx row-wise */
+  const double *theta;    /**< stage theta, n_elements x s x n_theta */
+  const double *lambda;   /**< stage lambda, n_elements x s x n_theta */
+  const double *mu;       /**< stage mu, n_elements x s x nsys */
+  int n_theta;            /**< total modes (sum of n_modes) */
+  int stages;
+} fesd_step_data;
+
+/** @brief Element data of the last accepted step (pointers valid until the next step). */
+FESD_API int fesd_last_step_data(const fesd_integrator *it, fesd_step_data *data);
+
+/** Accumulated statistics since fesd_set_state. */
+typedef struct {
+  int steps, switch_steps, newton_iter, factorizations, solves, homotopy_stages, splits;
+  int events;
+  double time;             /**< wall-clock seconds in fesd_step */
+  double max_iter_ordinary_step; /**< max Newton iterations of a step without switch */
+  double mean_iter_ordinary_step;
+  double max_iter_switch_step;
+  double mean_iter_switch_step;
+} fesd_stats;
+
+FESD_API int fesd_get_stats(const fesd_integrator *it, fesd_stats *stats);
+
+/** @brief Number of stacked modes (sum of n_modes) and subsystems. */
+FESD_API int fesd_dims(const fesd_integrator *it, int *n_theta, int *nsys);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

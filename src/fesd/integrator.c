@@ -1,0 +1,311 @@
+#include "fesd/integrator.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "common/timer.h"
+#include "fesd/step.h"
+
+int fesd_settings_default(fesd_settings *s) {
+  if (!s) return FESD_ERR_NULL;
+  memset(s, 0, sizeof(*s));
+  s->method = FESD_METHOD_FESD;
+  s->family = FESD_RK_RADAU_IIA;
+  s->stages = 2;
+  s->n_fe = 2;
+  s->newton_tol = 1e-12;
+  s->max_iter_first = 12;
+  s->max_iter = 40;
+  s->cc_tol = 1e-9;
+  s->active_tol = 1e-6;
+  s->exit_rows = 1;
+  s->max_splits = 6;
+  s->sensitivities = 0;
+  fesd_ncp_settings_default(&s->ncp);
+  return FESD_OK;
+}
+
+static int validate_settings(const fesd_settings *s) {
+  if (s->method != FESD_METHOD_FESD && s->method != FESD_METHOD_STANDARD) return FESD_ERR_INVALID_ARG;
+  if (s->n_fe < 1 || s->n_fe > 1000) return FESD_ERR_INVALID_ARG;
+  if (s->method == FESD_METHOD_FESD && s->n_fe < 2) return FESD_ERR_INVALID_ARG;
+  if (!(s->newton_tol > 0) || !(s->cc_tol > 0) || !(s->active_tol > 0)) return FESD_ERR_INVALID_ARG;
+  if (s->max_iter_first < 1 || s->max_iter < 1) return FESD_ERR_INVALID_ARG;
+  if (s->max_splits < 0 || s->max_splits > 12) return FESD_ERR_INVALID_ARG;
+  return FESD_OK;
+}
+
+void fesd_free(fesd_integrator **itp) {
+  if (!itp || !*itp) return;
+  fesd_integrator *it = *itp;
+  fesd_ncp_free(&it->ncp);
+  fesd__system_free(&it->sys);
+  fesd__model_free(&it->model);
+  double *bufs[] = {it->x, it->lam00, it->theta_prev, it->u_cur, it->z, it->zws, it->z0, it->zpred,
+                    it->raw, it->jac, it->lb, it->ub, it->bk_x, it->bk_lam, it->bk_th, it->bk_zws,
+                    it->bk_Sx, it->bk_Su, it->bk_ldp, it->Sx, it->Su, it->draw, it->dz, it->Dtmp,
+                    it->Stmp, it->gbuf, it->blk, it->pt_t, it->pt_q, it->rec_h, it->rec_t,
+                    it->rec_x, it->rec_th, it->rec_la, it->rec_mu};
+  for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); i++) free(bufs[i]);
+  free(it->eq_active);
+  free(it->pair_mode);
+  free(it->pt_src);
+  free(it->kb);
+  free(it->sw_at);
+  free(it);
+  *itp = NULL;
+}
+
+static double *dalloc(size_t n, int *fail) {
+  double *p = calloc(n > 0 ? n : 1, sizeof(double));
+  if (!p) *fail = 1;
+  return p;
+}
+
+int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_settings *settings) {
+  if (!itp) return FESD_ERR_NULL;
+  *itp = NULL;
+  if (!model) return FESD_ERR_NULL;
+  fesd_settings def;
+  if (!settings) {
+    fesd_settings_default(&def);
+    settings = &def;
+  }
+  int st = validate_settings(settings);
+  if (st) return st;
+  fesd_tableau tab;
+  if ((st = fesd_tableau_get(settings->family, settings->stages, &tab))) return st;
+  fesd_integrator *it = calloc(1, sizeof(*it));
+  if (!it) return FESD_ERR_NOMEM;
+  it->set = *settings;
+  if ((st = fesd__model_init(&it->model, model))) {
+    free(it);
+    return st;
+  }
+  if ((st = fesd__system_init(&it->sys, &it->model, &tab, settings->n_fe))) {
+    fesd__model_free(&it->model);
+    free(it);
+    return st;
+  }
+  fesd__system *S = &it->sys;
+  it->n = S->n;
+  it->nx = model->nx;
+  it->nu = model->nu;
+  it->nth = it->model.nth;
+  it->nsys = model->nsys;
+  it->N = S->N;
+  it->s = S->s;
+  it->np = it->nx + it->nu;
+  const size_t n = (size_t)S->n, nx = (size_t)it->nx, nu = (size_t)it->nu, nth = (size_t)it->nth;
+  const size_t np = (size_t)it->np, N = (size_t)S->N, s = (size_t)S->s;
+  int fail = 0;
+  it->x = dalloc(nx, &fail);
+  it->lam00 = dalloc(nth, &fail);
+  it->theta_prev = dalloc(nth, &fail);
+  it->u_cur = dalloc(nu, &fail);
+  it->z = dalloc(n, &fail);
+  it->zws = dalloc(n, &fail);
+  it->z0 = dalloc(n, &fail);
+  it->zpred = dalloc(n, &fail);
+  it->raw = dalloc((size_t)S->n_raw, &fail);
+  it->jac = dalloc((size_t)S->nnz, &fail);
+  it->lb = dalloc(n, &fail);
+  it->ub = dalloc(n, &fail);
+  it->bk_x = dalloc(nx, &fail);
+  it->bk_lam = dalloc(nth, &fail);
+  it->bk_th = dalloc(nth, &fail);
+  it->bk_zws = dalloc(n, &fail);
+  it->bk_Sx = dalloc(nx * nx, &fail);
+  it->bk_Su = dalloc(nx * nu, &fail);
+  it->bk_ldp = dalloc(nth * np, &fail);
+  it->Sx = dalloc(nx * nx, &fail);
+  it->Su = dalloc(nx * nu, &fail);
+  if (settings->sensitivities) {
+    it->draw = dalloc((size_t)S->n_raw * np, &fail);
+    it->dz = dalloc(n * np, &fail);
+  }
+  it->Dtmp = dalloc((nx > nth ? nx : nth) * np, &fail);
+  it->Stmp = dalloc(nx * (nx > nu ? nx : nu), &fail);
+  it->gbuf = dalloc(nth + nx, &fail);
+  it->blk = dalloc((size_t)S->sb, &fail);
+  it->pt_t = dalloc(N * s + 1, &fail);
+  it->pt_q = dalloc((N * s + 1) * nth, &fail);
+  it->cap_el = (int)N << settings->max_splits;
+  size_t cap = (size_t)it->cap_el;
+  it->rec_h = dalloc(cap, &fail);
+  it->rec_t = dalloc(cap + 1, &fail);
+  it->rec_x = dalloc((cap + 1) * nx, &fail);
+  it->rec_th = dalloc(cap * s * nth, &fail);
+  it->rec_la = dalloc(cap * s * nth, &fail);
+  it->rec_mu = dalloc(cap * s * (size_t)it->nsys, &fail);
+  it->eq_active = malloc((size_t)S->n_eq);
+  it->pair_mode = malloc((size_t)(S->n_pair > 0 ? S->n_pair : 1));
+  it->pt_src = malloc((N * s + 1) * sizeof(int));
+  it->kb = malloc((N + 1) * sizeof(int));
+  it->sw_at = malloc((N + 1) * sizeof(int));
+  if (fail || !it->eq_active || !it->pair_mode || !it->pt_src || !it->kb || !it->sw_at) {
+    fesd_free(&it);
+    return FESD_ERR_NOMEM;
+  }
+  fesd_ncp_problem p = {S->n, S->n_eq, S->n_pair, S->nnz, S->prow, S->pcol, fesd__system_eval, S};
+  fesd_ncp_settings ns = settings->ncp;
+  ns.tol = settings->newton_tol;
+  if ((st = fesd_ncp_setup(&it->ncp, &p, &ns))) {
+    fesd_free(&it);
+    return st;
+  }
+  *itp = it;
+  return FESD_OK;
+}
+
+int fesd_set_state(fesd_integrator *it, double t0, const double *x0, const double *u) {
+  if (!it || !x0 || (it->nu > 0 && !u)) return FESD_ERR_NULL;
+  if (!isfinite(t0)) return FESD_ERR_INVALID_ARG;
+  for (int i = 0; i < it->nx; i++)
+    if (!isfinite(x0[i])) return FESD_ERR_INVALID_ARG;
+  it->t = t0;
+  memcpy(it->x, x0, (size_t)it->nx * sizeof(double));
+  it->have_ws = 0;
+  it->have_prev_theta = 0;
+  memset(it->Sx, 0, (size_t)it->nx * it->nx * sizeof(double));
+  for (int i = 0; i < it->nx; i++) it->Sx[i * it->nx + i] = 1.0;
+  if (it->nu > 0) memset(it->Su, 0, (size_t)it->nx * it->nu * sizeof(double));
+  memset(&it->stats, 0, sizeof(it->stats));
+  it->sum_iter_ord = it->sum_iter_sw = 0;
+  it->n_el = 0;
+  it->n_events = 0;
+  /* lambda00 = g(x0) - min g (paper Sec. 3.2.2), with its derivative for sensitivities */
+  int st = fesd__update_lambda00(it, x0, u, it->set.sensitivities);
+  it->have_state = (st == FESD_OK);
+  return st;
+}
+
+static void backup(fesd_integrator *it, double *t, int *flags) {
+  const size_t nx = (size_t)it->nx, nth = (size_t)it->nth, nu = (size_t)it->nu;
+  *t = it->t;
+  flags[0] = it->have_ws;
+  flags[1] = it->have_prev_theta;
+  memcpy(it->bk_x, it->x, nx * sizeof(double));
+  memcpy(it->bk_lam, it->lam00, nth * sizeof(double));
+  memcpy(it->bk_th, it->theta_prev, nth * sizeof(double));
+  memcpy(it->bk_zws, it->zws, (size_t)it->n * sizeof(double));
+  memcpy(it->bk_Sx, it->Sx, nx * nx * sizeof(double));
+  memcpy(it->bk_Su, it->Su, nx * nu * sizeof(double));
+  memcpy(it->bk_ldp, it->sys.lam00_dp, nth * (size_t)it->np * sizeof(double));
+}
+
+static void restore(fesd_integrator *it, double t, const int *flags) {
+  const size_t nx = (size_t)it->nx, nth = (size_t)it->nth, nu = (size_t)it->nu;
+  it->t = t;
+  it->have_ws = flags[0];
+  it->have_prev_theta = flags[1];
+  memcpy(it->x, it->bk_x, nx * sizeof(double));
+  memcpy(it->lam00, it->bk_lam, nth * sizeof(double));
+  memcpy(it->theta_prev, it->bk_th, nth * sizeof(double));
+  memcpy(it->zws, it->bk_zws, (size_t)it->n * sizeof(double));
+  memcpy(it->Sx, it->bk_Sx, nx * nx * sizeof(double));
+  memcpy(it->Su, it->bk_Su, nx * nu * sizeof(double));
+  memcpy(it->sys.lam00_dp, it->bk_ldp, nth * (size_t)it->np * sizeof(double));
+}
+
+int fesd_step(fesd_integrator *it, const double *u, double T, fesd_step_info *info) {
+  fesd_step_info local;
+  if (!info) info = &local;
+  memset(info, 0, sizeof(*info));
+  if (!it) return info->status = FESD_ERR_NULL;
+  if (it->nu > 0 && !u) return info->status = FESD_ERR_NULL;
+  if (!it->have_state) return info->status = FESD_ERR_NOT_READY;
+  if (!(T > 0) || !isfinite(T)) return info->status = FESD_ERR_INVALID_ARG;
+  for (int i = 0; i < it->nu; i++)
+    if (!isfinite(u[i])) return info->status = FESD_ERR_INVALID_ARG;
+  double t0 = fesd__wall_time(), tb;
+  int flags[2];
+  backup(it, &tb, flags);
+  it->n_el = 0;
+  it->n_events = 0;
+  it->model.failed = NULL;
+  int st = fesd__substep(it, u, T, 0, info);
+  info->time = fesd__wall_time() - t0;
+  info->status = st;
+  if (st != FESD_OK) {
+    info->failed_time = it->t;
+    if (!info->failed_callback && (st == FESD_ERR_CALLBACK || st == FESD_ERR_NONFINITE))
+      info->failed_callback = it->model.failed;
+    restore(it, tb, flags);
+    it->n_el = 0;
+    it->n_events = 0;
+    return st;
+  }
+  fesd_stats *S = &it->stats;
+  S->steps++;
+  S->newton_iter += info->newton_iter;
+  S->factorizations += info->factorizations;
+  S->solves += info->solves;
+  S->homotopy_stages += info->homotopy_stages;
+  S->splits += info->splits;
+  S->events += it->n_events;
+  S->time += info->time;
+  int sw = info->switch_step || info->splits > 0;
+  if (sw) {
+    S->switch_steps++;
+    it->sum_iter_sw += info->newton_iter;
+    if (info->newton_iter > S->max_iter_switch_step) S->max_iter_switch_step = info->newton_iter;
+    S->mean_iter_switch_step = it->sum_iter_sw / S->switch_steps;
+  } else {
+    int ord = S->steps - S->switch_steps;
+    it->sum_iter_ord += info->newton_iter;
+    if (info->newton_iter > S->max_iter_ordinary_step) S->max_iter_ordinary_step = info->newton_iter;
+    S->mean_iter_ordinary_step = it->sum_iter_ord / ord;
+  }
+  return FESD_OK;
+}
+
+int fesd_get_state(const fesd_integrator *it, double *t, double *x) {
+  if (!it) return FESD_ERR_NULL;
+  if (t) *t = it->t;
+  if (x) memcpy(x, it->x, (size_t)it->nx * sizeof(double));
+  return FESD_OK;
+}
+
+int fesd_get_sensitivities(const fesd_integrator *it, double *Sx, double *Su) {
+  if (!it) return FESD_ERR_NULL;
+  if (!it->set.sensitivities) return FESD_ERR_NOT_READY;
+  if (Sx) memcpy(Sx, it->Sx, (size_t)it->nx * it->nx * sizeof(double));
+  if (Su && it->nu > 0) memcpy(Su, it->Su, (size_t)it->nx * it->nu * sizeof(double));
+  return FESD_OK;
+}
+
+int fesd_last_events(const fesd_integrator *it, const fesd_event **events, int *count) {
+  if (!it || !events || !count) return FESD_ERR_NULL;
+  *events = it->events;
+  *count = it->n_events;
+  return FESD_OK;
+}
+
+int fesd_last_step_data(const fesd_integrator *it, fesd_step_data *d) {
+  if (!it || !d) return FESD_ERR_NULL;
+  d->n_elements = it->n_el;
+  d->h = it->rec_h;
+  d->t = it->rec_t;
+  d->x = it->rec_x;
+  d->theta = it->rec_th;
+  d->lambda = it->rec_la;
+  d->mu = it->rec_mu;
+  d->n_theta = it->nth;
+  d->stages = it->s;
+  return FESD_OK;
+}
+
+int fesd_get_stats(const fesd_integrator *it, fesd_stats *stats) {
+  if (!it || !stats) return FESD_ERR_NULL;
+  *stats = it->stats;
+  return FESD_OK;
+}
+
+int fesd_dims(const fesd_integrator *it, int *n_theta, int *nsys) {
+  if (!it) return FESD_ERR_NULL;
+  if (n_theta) *n_theta = it->nth;
+  if (nsys) *nsys = it->nsys;
+  return FESD_OK;
+}

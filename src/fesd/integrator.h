@@ -1,0 +1,41 @@
+/* Internal definition of the integrator object (src/fesd). */
+#ifndef FESD_INTEGRATOR_INTERNAL_H
+#define FESD_INTEGRATOR_INTERNAL_H
+
+#include "fesd/model.h"
+#include "fesd/system.h"
+#include "fesd_integrator.h"
+#include "fesd_ncp.h"
+
+#define FESD_MAX_EVENTS_PER_STEP 256
+
+struct fesd_integrator {
+  fesd_settings set;
+  fesd__model model;
+  fesd__system sys;
+  fesd_ncp *ncp;
+  int n, nx, nu, nth, nsys, N, s, np;
+  /* current state */
+  double t;
+  double *x, *lam00, *theta_prev, *u_cur;
+  int have_state, have_ws, have_prev_theta;
+  /* step data */
+  double *z, *zws, *z0, *zpred, *raw, *jac, *lb, *ub;
+  unsigned char *eq_active, *pair_mode;
+  /* backup of the state for a failed fesd_step (restored: the state stays unchanged) */
+  double *bk_x, *bk_lam, *bk_th, *bk_zws, *bk_Sx, *bk_Su, *bk_ldp;
+  /* sensitivities */
+  double *Sx, *Su, *draw, *dz, *Dtmp, *Stmp;
+  double *gbuf, *blk;
+  double *pt_t, *pt_q; /* switch prediction: point times and q values */
+  int *pt_src, *kb, *sw_at;
+  /* records of the last accepted step */
+  int cap_el, n_el;
+  double *rec_h, *rec_t, *rec_x, *rec_th, *rec_la, *rec_mu;
+  fesd_event events[FESD_MAX_EVENTS_PER_STEP];
+  int n_events;
+  fesd_stats stats;
+  double sum_iter_ord, sum_iter_sw;
+};
+
+#endif

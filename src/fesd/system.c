@@ -1,0 +1,482 @@
+#include "fesd/system.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+void fesd__system_free(fesd__system *S) {
+  if (!S) return;
+  if (S->pe) {
+    int np = S->N * S->s + S->N;
+    for (int p = 0; p < np; p++) {
+      free(S->pe[p].F);
+      free(S->pe[p].g);
+      free(S->pe[p].dFdx);
+      free(S->pe[p].dgdx);
+      free(S->pe[p].dFdu);
+      free(S->pe[p].dgdu);
+    }
+  }
+  free(S->pe);
+  free(S->el);
+  free(S->xo);
+  free(S->ho);
+  free(S->lbo);
+  free(S->rel);
+  free(S->rlb);
+  free(S->rx);
+  free(S->prow);
+  free(S->pcol);
+  free(S->X);
+  free(S->Jth);
+  free(S->Juth);
+  free(S->lam00_dp);
+  free(S->tmp);
+  memset(S, 0, sizeof(*S));
+}
+
+const double *fesd__right_lambda(const fesd__system *S, const double *z, int n) {
+  if (!S->bp) return z + fesd__la(S, n, S->s - 1);
+  return S->lbo[n] >= 0 ? z + S->lbo[n] : NULL;
+}
+
+const double *fesd__left_lambda(const fesd__system *S, const double *z, int n) {
+  return n == 0 ? S->lam00 : fesd__right_lambda(S, z, n - 1);
+}
+
+/* State at the start of element n. */
+static const double *elem_start(const fesd__system *S, const double *z, int n) {
+  return n == 0 ? S->x0 : z + S->xo[n - 1];
+}
+
+double fesd__cross_value(const fesd__system *S, const double *z, int n) {
+  int s = S->s, nth = S->nth;
+  const double *L = fesd__left_lambda(S, z, n);
+  const double *R = S->bp ? fesd__right_lambda(S, z, n) : NULL;
+  double c = 0;
+  for (int i = 0; i < nth; i++) {
+    double Th = 0, Lt = L[i] + (R ? R[i] : 0), diag = 0;
+    for (int j = 0; j < s; j++) {
+      double th = z[fesd__th(S, n, j) + i], la = z[fesd__la(S, n, j) + i];
+      Th += th;
+      Lt += la;
+      diag += th * la;
+    }
+    c += Th * Lt - diag;
+  }
+  return c;
+}
+
+/* ---- Jacobian emission: one traversal writes either the pattern or the values,
+ *      so both always agree. ---- */
+typedef struct {
+  int k, pattern;
+  int *row, *col;
+  double *val;
+} emitter;
+
+#define EMIT(E, r, c, expr)    \
+  do {                         \
+    if ((E)->pattern) {        \
+      (E)->row[(E)->k] = (r);  \
+      (E)->col[(E)->k] = (c);  \
+    } else {                   \
+      (E)->val[(E)->k] = (expr); \
+    }                          \
+    (E)->k++;                  \
+  } while (0)
+
+/* Stage-point scratch: p = n*s + j for stages, N*s + n for boundary points. */
+static void emit_jacobian(const fesd__system *S, const double *z, emitter *E) {
+  const int N = S->N, s = S->s, nx = S->nx, nth = S->nth, nsys = S->nsys;
+  const fesd__model *m = S->model;
+  for (int n = 0; n < N; n++) {
+    const double h = E->pattern ? 0 : z[S->ho[n]];
+    for (int j = 0; j < s; j++) {
+      const int p = n * s + j;
+      const fesd__point_eval *pe = &S->pe[p];
+      const double *Jth = S->Jth + (size_t)p * nx * nx;
+      const int rV = S->rel[n] + j * S->rs, rG = rV + nx, rS = rG + nth;
+      const double *X = S->X + (size_t)p * nx;
+      /* V rows: v_j - F(X) theta_j */
+      for (int l = 0; l < s; l++) {
+        const double a = S->tab.A[j][l];
+        for (int c = 0; c < nx; c++)
+          for (int r = 0; r < nx; r++)
+            EMIT(E, rV + r, fesd__v(S, n, l) + c, (j == l && r == c ? 1.0 : 0.0) - h * a * Jth[c * nx + r]);
+      }
+      if (n > 0)
+        for (int c = 0; c < nx; c++)
+          for (int r = 0; r < nx; r++) EMIT(E, rV + r, S->xo[n - 1] + c, -Jth[c * nx + r]);
+      /* d/dh: X = x_n + h * K_j with K_j = (X - x_n)/h; use sum_l a_jl v_l directly. */
+      for (int r = 0; r < nx; r++) {
+        double val = 0;
+        if (!E->pattern) {
+          for (int c = 0; c < nx; c++) {
+            double kc = 0;
+            for (int l = 0; l < s; l++) kc += S->tab.A[j][l] * z[fesd__v(S, n, l) + c];
+            val -= Jth[c * nx + r] * kc;
+          }
+        }
+        EMIT(E, rV + r, S->ho[n], val);
+      }
+      for (int i = 0; i < nth; i++)
+        for (int r = 0; r < nx; r++) EMIT(E, rV + r, fesd__th(S, n, j) + i, -pe->F[i * nx + r]);
+      (void)X;
+      /* G rows: g(X) - lambda - mu e */
+      for (int l = 0; l < s; l++) {
+        const double a = S->tab.A[j][l];
+        for (int c = 0; c < nx; c++)
+          for (int i = 0; i < nth; i++) EMIT(E, rG + i, fesd__v(S, n, l) + c, h * a * pe->dgdx[c * nth + i]);
+      }
+      if (n > 0)
+        for (int c = 0; c < nx; c++)
+          for (int i = 0; i < nth; i++) EMIT(E, rG + i, S->xo[n - 1] + c, pe->dgdx[c * nth + i]);
+      for (int i = 0; i < nth; i++) {
+        double val = 0;
+        if (!E->pattern)
+          for (int c = 0; c < nx; c++) {
+            double kc = 0;
+            for (int l = 0; l < s; l++) kc += S->tab.A[j][l] * z[fesd__v(S, n, l) + c];
+            val += pe->dgdx[c * nth + i] * kc;
+          }
+        EMIT(E, rG + i, S->ho[n], val);
+        EMIT(E, rG + i, fesd__la(S, n, j) + i, -1.0);
+        EMIT(E, rG + i, fesd__mu(S, n, j) + m->sys_of[i], -1.0);
+      }
+      /* S rows: 1 - e'theta per subsystem */
+      for (int i = 0; i < nth; i++) EMIT(E, rS + m->sys_of[i], fesd__th(S, n, j) + i, -1.0);
+    }
+    if (S->lbo[n] >= 0) {
+      const fesd__point_eval *pb = &S->pe[N * s + n];
+      const int rL = S->rlb[n], rM = rL + nth, lb = S->lbo[n];
+      for (int c = 0; c < nx; c++)
+        for (int i = 0; i < nth; i++) EMIT(E, rL + i, S->xo[n] + c, pb->dgdx[c * nth + i]);
+      for (int i = 0; i < nth; i++) {
+        EMIT(E, rL + i, lb + i, -1.0);
+        EMIT(E, rL + i, lb + nth + m->sys_of[i], -1.0);
+      }
+      for (int i = 0; i < nth; i++) {
+        EMIT(E, rM + m->sys_of[i], fesd__th(S, n, s - 1) + i, z ? z[lb + i] : 0.0);
+        EMIT(E, rM + m->sys_of[i], lb + i, z ? z[fesd__th(S, n, s - 1) + i] : 0.0);
+      }
+    }
+    /* X rows: x_{n+1} - x_n - h sum b_j v_j */
+    const int rX = S->rx[n];
+    for (int r = 0; r < nx; r++) {
+      EMIT(E, rX + r, S->xo[n] + r, 1.0);
+      if (n > 0) EMIT(E, rX + r, S->xo[n - 1] + r, -1.0);
+      double val = 0;
+      if (!E->pattern)
+        for (int j = 0; j < s; j++) val -= S->tab.b[j] * z[fesd__v(S, n, j) + r];
+      EMIT(E, rX + r, S->ho[n], val);
+      for (int j = 0; j < s; j++) EMIT(E, rX + r, fesd__v(S, n, j) + r, -h * S->tab.b[j]);
+    }
+  }
+  (void)nsys;
+  /* boundary rows */
+  for (int k = 1; k < N; k++) {
+    EMIT(E, fesd__rowH(S, k), S->ho[k], 1.0);
+    EMIT(E, fesd__rowH(S, k), S->ho[k - 1], -1.0);
+    const int rC = fesd__rowC(S, k);
+    for (int n = k - 1; n <= k; n++) {
+      const double *L = E->pattern ? NULL : fesd__left_lambda(S, z, n);
+      const double *R = (S->bp && S->lbo[n] >= 0 && !E->pattern) ? z + S->lbo[n] : NULL;
+      for (int i = 0; i < nth; i++) {
+        double Th = 0, Lt = 0;
+        if (!E->pattern) {
+          Lt = L[i] + (R ? R[i] : 0);
+          for (int j = 0; j < s; j++) {
+            Th += z[fesd__th(S, n, j) + i];
+            Lt += z[fesd__la(S, n, j) + i];
+          }
+        }
+        for (int j = 0; j < s; j++) {
+          EMIT(E, rC, fesd__th(S, n, j) + i, Lt - z[fesd__la(S, n, j) + i]);
+          EMIT(E, rC, fesd__la(S, n, j) + i, Th - z[fesd__th(S, n, j) + i]);
+        }
+        if (n > 0) {
+          int col = S->bp ? S->lbo[n - 1] + i : fesd__la(S, n - 1, s - 1) + i;
+          EMIT(E, rC, col, Th);
+        }
+        if (S->bp && S->lbo[n] >= 0) EMIT(E, rC, S->lbo[n] + i, Th);
+      }
+    }
+  }
+  for (int n = 0; n < N; n++) EMIT(E, S->rT, S->ho[n], 1.0);
+  /* pair rows: a = theta, b = lambda */
+  for (int n = 0; n < N; n++)
+    for (int j = 0; j < s; j++)
+      for (int i = 0; i < nth; i++) {
+        int p = fesd__pair(S, n, j, i);
+        EMIT(E, S->n_eq + p, fesd__th(S, n, j) + i, 1.0);
+        EMIT(E, S->n_eq + S->n_pair + p, fesd__la(S, n, j) + i, 1.0);
+      }
+}
+
+int fesd__system_init(fesd__system *S, fesd__model *m, const fesd_tableau *tab, int N) {
+  memset(S, 0, sizeof(*S));
+  S->model = m;
+  S->tab = *tab;
+  S->N = N;
+  S->s = tab->s;
+  S->nx = m->nx;
+  S->nth = m->nth;
+  S->nsys = m->nsys;
+  S->nu = m->nu;
+  S->bp = !tab->stiffly_accurate;
+  const int s = S->s, nx = S->nx, nth = S->nth, nsys = S->nsys, nu = S->nu;
+  S->sb = nx + 2 * nth + nsys;
+  S->rs = nx + nth + nsys;
+  S->el = malloc((size_t)N * sizeof(int));
+  S->xo = malloc((size_t)N * sizeof(int));
+  S->ho = malloc((size_t)N * sizeof(int));
+  S->lbo = malloc((size_t)N * sizeof(int));
+  S->rel = malloc((size_t)N * sizeof(int));
+  S->rlb = malloc((size_t)N * sizeof(int));
+  S->rx = malloc((size_t)N * sizeof(int));
+  if (!S->el || !S->xo || !S->ho || !S->lbo || !S->rel || !S->rlb || !S->rx) goto nomem;
+  int off = 0, row = 0;
+  for (int n = 0; n < N; n++) {
+    S->el[n] = off;
+    S->rel[n] = row;
+    off += s * S->sb;
+    row += s * S->rs;
+    if (S->bp && n < N - 1) {
+      S->lbo[n] = off;
+      S->rlb[n] = row;
+      off += nth + nsys;
+      row += nth + nsys;
+    } else {
+      S->lbo[n] = S->rlb[n] = -1;
+    }
+    S->xo[n] = off;
+    S->rx[n] = row;
+    off += nx;
+    row += nx;
+    S->ho[n] = off;
+    off += 1;
+  }
+  S->n = off;
+  S->rH0 = row;
+  S->rC0 = row + (N - 1);
+  S->rT = row + 2 * (N - 1);
+  S->n_eq = S->rT + 1;
+  S->n_pair = N * s * nth;
+  S->n_raw = S->n_eq + 2 * S->n_pair;
+  int np = N * s + N;
+  S->pe = calloc((size_t)np, sizeof(*S->pe));
+  S->X = malloc((size_t)np * nx * sizeof(double));
+  S->Jth = malloc((size_t)N * s * nx * nx * sizeof(double));
+  S->Juth = malloc((size_t)N * s * nx * (nu > 0 ? nu : 1) * sizeof(double));
+  S->lam00_dp = malloc((size_t)nth * (nx + nu) * sizeof(double));
+  S->tmp = malloc((size_t)(nx + nth) * sizeof(double));
+  if (!S->pe || !S->X || !S->Jth || !S->Juth || !S->lam00_dp || !S->tmp) goto nomem;
+  for (int p = 0; p < np; p++) {
+    fesd__point_eval *pe = &S->pe[p];
+    int stage = p < N * s;
+    pe->g = malloc((size_t)nth * sizeof(double));
+    pe->dgdx = malloc((size_t)nth * nx * sizeof(double));
+    pe->dgdu = malloc((size_t)nth * (nu > 0 ? nu : 1) * sizeof(double));
+    if (!pe->g || !pe->dgdx || !pe->dgdu) goto nomem;
+    if (stage) {
+      pe->F = malloc((size_t)nx * nth * sizeof(double));
+      pe->dFdx = malloc((size_t)nth * nx * nx * sizeof(double));
+      pe->dFdu = malloc((size_t)nth * nx * (nu > 0 ? nu : 1) * sizeof(double));
+      if (!pe->F || !pe->dFdx || !pe->dFdu) goto nomem;
+    }
+  }
+  /* pattern: count, then record */
+  emitter E = {0, 1, NULL, NULL, NULL};
+  {
+    /* counting pass: pattern mode with throwaway arrays sized by a first dry count */
+    int cnt = 0;
+    for (int n = 0; n < N; n++) {
+      cnt += s * (s * nx * nx + (n > 0) * nx * nx + nx + nth * nx); /* V rows */
+      cnt += s * (s * nx * nth + (n > 0) * nx * nth + 3 * nth);      /* G rows */
+      cnt += s * nth;                                                  /* S rows */
+      if (S->lbo[n] >= 0) cnt += nx * nth + 2 * nth + 2 * nth;
+      cnt += nx * (2 + (n > 0) + s);
+    }
+    for (int k = 1; k < N; k++) {
+      cnt += 2;
+      for (int n = k - 1; n <= k; n++) cnt += nth * (2 * s + (n > 0) + (S->bp && S->lbo[n] >= 0));
+    }
+    cnt += N + 2 * S->n_pair;
+    S->nnz = cnt;
+  }
+  S->prow = malloc((size_t)S->nnz * sizeof(int));
+  S->pcol = malloc((size_t)S->nnz * sizeof(int));
+  if (!S->prow || !S->pcol) goto nomem;
+  E.row = S->prow;
+  E.col = S->pcol;
+  emit_jacobian(S, NULL, &E);
+  if (E.k != S->nnz) { /* internal consistency: the count formula must match */
+    fesd__system_free(S);
+    return FESD_ERR_PATTERN;
+  }
+  return FESD_OK;
+nomem:
+  fesd__system_free(S);
+  return FESD_ERR_NOMEM;
+}
+
+/* Evaluate the model at every stage point (and boundary point) of z. */
+static int eval_points(fesd__system *S, const double *z, int want_jac) {
+  const int N = S->N, s = S->s, nx = S->nx, nth = S->nth, nu = S->nu;
+  fesd__model *m = S->model;
+  for (int n = 0; n < N; n++) {
+    const double *xn = elem_start(S, z, n);
+    const double h = z[S->ho[n]];
+    for (int j = 0; j < s; j++) {
+      const int p = n * s + j;
+      double *X = S->X + (size_t)p * nx;
+      for (int r = 0; r < nx; r++) {
+        double acc = 0;
+        for (int l = 0; l < s; l++) acc += S->tab.A[j][l] * z[fesd__v(S, n, l) + r];
+        X[r] = xn[r] + h * acc;
+      }
+      fesd__point_eval pe = S->pe[p];
+      if (!want_jac) pe.dFdx = pe.dgdx = NULL;
+      if (!(want_jac && S->want_u)) pe.dFdu = pe.dgdu = NULL;
+      int st = fesd__model_eval(m, X, S->u, &pe);
+      if (st) return st;
+      if (want_jac) {
+        const double *th = z + fesd__th(S, n, j);
+        double *J = S->Jth + (size_t)p * nx * nx;
+        memset(J, 0, (size_t)nx * nx * sizeof(double));
+        for (int i = 0; i < nth; i++) {
+          if (th[i] == 0.0) continue;
+          const double *d = pe.dFdx + (size_t)i * nx * nx;
+          for (int q = 0; q < nx * nx; q++) J[q] += th[i] * d[q];
+        }
+        if (S->want_u && nu > 0) {
+          double *Ju = S->Juth + (size_t)p * nx * nu;
+          memset(Ju, 0, (size_t)nx * nu * sizeof(double));
+          for (int i = 0; i < nth; i++) {
+            const double *d = pe.dFdu + (size_t)i * nx * nu;
+            for (int q = 0; q < nx * nu; q++) Ju[q] += th[i] * d[q];
+          }
+        }
+      }
+    }
+    if (S->lbo[n] >= 0) {
+      fesd__point_eval pb = S->pe[N * s + n];
+      pb.F = pb.dFdx = pb.dFdu = NULL;
+      if (!want_jac) pb.dgdx = NULL;
+      if (!(want_jac && S->want_u)) pb.dgdu = NULL;
+      int st = fesd__model_eval(m, z + S->xo[n], S->u, &pb);
+      if (st) return st;
+    }
+  }
+  return FESD_OK;
+}
+
+int fesd__system_eval(const double *z, double *raw, double *jac, void *ctx) {
+  fesd__system *S = ctx;
+  const int N = S->N, s = S->s, nx = S->nx, nth = S->nth, nsys = S->nsys;
+  const fesd__model *m = S->model;
+  int st = eval_points(S, z, jac != NULL);
+  S->status = st;
+  if (st) return 1;
+  for (int n = 0; n < N; n++) {
+    const double *xn = elem_start(S, z, n);
+    const double h = z[S->ho[n]];
+    for (int j = 0; j < s; j++) {
+      const int p = n * s + j;
+      const fesd__point_eval *pe = &S->pe[p];
+      const int rV = S->rel[n] + j * S->rs, rG = rV + nx, rS = rG + nth;
+      const double *v = z + fesd__v(S, n, j), *th = z + fesd__th(S, n, j);
+      const double *la = z + fesd__la(S, n, j), *mu = z + fesd__mu(S, n, j);
+      for (int r = 0; r < nx; r++) {
+        double acc = v[r];
+        for (int i = 0; i < nth; i++) acc -= pe->F[i * nx + r] * th[i];
+        raw[rV + r] = acc;
+      }
+      for (int i = 0; i < nth; i++) raw[rG + i] = pe->g[i] - la[i] - mu[m->sys_of[i]];
+      for (int k = 0; k < nsys; k++) raw[rS + k] = 1.0;
+      for (int i = 0; i < nth; i++) raw[rS + m->sys_of[i]] -= th[i];
+    }
+    if (S->lbo[n] >= 0) {
+      const fesd__point_eval *pb = &S->pe[N * s + n];
+      const double *LB = z + S->lbo[n], *MB = LB + nth, *th = z + fesd__th(S, n, s - 1);
+      const int rL = S->rlb[n], rM = rL + nth;
+      for (int i = 0; i < nth; i++) raw[rL + i] = pb->g[i] - LB[i] - MB[m->sys_of[i]];
+      for (int k = 0; k < nsys; k++) raw[rM + k] = 0.0;
+      for (int i = 0; i < nth; i++) raw[rM + m->sys_of[i]] += th[i] * LB[i];
+    }
+    const double *x1 = z + S->xo[n];
+    for (int r = 0; r < nx; r++) {
+      double acc = x1[r] - xn[r];
+      for (int j = 0; j < s; j++) acc -= h * S->tab.b[j] * z[fesd__v(S, n, j) + r];
+      raw[S->rx[n] + r] = acc;
+    }
+  }
+  double hs = 0;
+  for (int n = 0; n < N; n++) hs += z[S->ho[n]];
+  for (int k = 1; k < N; k++) {
+    raw[fesd__rowH(S, k)] = z[S->ho[k]] - z[S->ho[k - 1]];
+    raw[fesd__rowC(S, k)] = fesd__cross_value(S, z, k - 1) + fesd__cross_value(S, z, k);
+  }
+  raw[S->rT] = hs - S->T;
+  for (int n = 0; n < N; n++)
+    for (int j = 0; j < s; j++)
+      for (int i = 0; i < nth; i++) {
+        int p = fesd__pair(S, n, j, i);
+        raw[S->n_eq + p] = z[fesd__th(S, n, j) + i];
+        raw[S->n_eq + S->n_pair + p] = z[fesd__la(S, n, j) + i];
+      }
+  if (jac) {
+    emitter E = {0, 0, NULL, NULL, jac};
+    emit_jacobian(S, z, &E);
+  }
+  return 0;
+}
+
+int fesd__system_param_jac(fesd__system *S, const double *z, double *out) {
+  const int N = S->N, s = S->s, nx = S->nx, nth = S->nth, nu = S->nu, np = nx + nu;
+  const int ld = S->n_raw;
+  memset(out, 0, (size_t)ld * np * sizeof(double));
+  /* element 0 depends on x_start explicitly */
+  for (int j = 0; j < s; j++) {
+    const int p = j;
+    const double *Jth = S->Jth + (size_t)p * nx * nx;
+    const fesd__point_eval *pe = &S->pe[p];
+    const int rV = S->rel[0] + j * S->rs, rG = rV + nx;
+    for (int c = 0; c < nx; c++) {
+      for (int r = 0; r < nx; r++) out[(size_t)c * ld + rV + r] = -Jth[c * nx + r];
+      for (int i = 0; i < nth; i++) out[(size_t)c * ld + rG + i] = pe->dgdx[c * nth + i];
+    }
+  }
+  for (int r = 0; r < nx; r++) out[(size_t)r * ld + S->rx[0] + r] = -1.0;
+  /* u: every stage point and boundary point */
+  if (nu > 0) {
+    for (int n = 0; n < N; n++) {
+      for (int j = 0; j < s; j++) {
+        const int p = n * s + j;
+        const double *Ju = S->Juth + (size_t)p * nx * nu;
+        const fesd__point_eval *pe = &S->pe[p];
+        const int rV = S->rel[n] + j * S->rs, rG = rV + nx;
+        for (int c = 0; c < nu; c++) {
+          for (int r = 0; r < nx; r++) out[(size_t)(nx + c) * ld + rV + r] = -Ju[c * nx + r];
+          for (int i = 0; i < nth; i++) out[(size_t)(nx + c) * ld + rG + i] = pe->dgdu[c * nth + i];
+        }
+      }
+      if (S->lbo[n] >= 0) {
+        const fesd__point_eval *pb = &S->pe[N * s + n];
+        for (int c = 0; c < nu; c++)
+          for (int i = 0; i < nth; i++)
+            out[(size_t)(nx + c) * ld + S->rlb[n] + i] = pb->dgdu[c * nth + i];
+      }
+    }
+  }
+  /* lambda00 enters C(1) through element 0: d/dlam00_i = Theta_{0,i}. */
+  if (N > 1) {
+    const int rC = fesd__rowC(S, 1);
+    for (int i = 0; i < nth; i++) {
+      double Th = 0;
+      for (int j = 0; j < s; j++) Th += z[fesd__th(S, 0, j) + i];
+      for (int c = 0; c < np; c++) out[(size_t)c * ld + rC] += Th * S->lam00_dp[c * nth + i];
+    }
+  }
+  return FESD_OK;
+}

@@ -1,0 +1,86 @@
+/* Internal: the discretised equations of one integration step [t, t+T] with N
+ * finite elements of an s-stage RK method (paper eq. dcs_irk / fesd_compact),
+ * as a problem for the semismooth Newton solver (src/ncp).
+ *
+ * Unknowns, element by element: for each stage j: v (nx), theta (nth),
+ * lambda (nth), mu (nsys); for methods whose last stage is not the element end
+ * (not stiffly accurate: Gauss-Legendre, explicit RK) and n < N-1 the boundary
+ * LP values LB (nth), MB (nsys) at x_{n+1} (paper Sec. 3.2.5 / 4.2.1); then
+ * x_{n+1} (nx) and h_n.
+ * Smooth rows, element by element: per stage  v - F(X) theta,  g(X) - lambda - mu e,
+ * 1 - e'theta  (per subsystem); boundary LP rows  g(x_{n+1}) - LB - MB e  and
+ * theta_{n,s}' LB = 0 (per subsystem: fixes MB as the indicator of the active
+ * mode); continuity  x_{n+1} - x_n - h sum b_j v_j. Then the candidate boundary
+ * rows for k = 1..N-1: H(k): h_k - h_{k-1} and C(k): C_{k-1} + C_k (compact cross
+ * complementarity, eq. cross_comp); last T: sum h - T.
+ * Pairs: (theta_{n,j,i}, lambda_{n,j,i}).
+ * The solver's row selection chooses, per boundary, H or C (or neither at a
+ * pinned sliding exit, where the pair of the dropping mode is PIN). */
+#ifndef FESD_SYSTEM_H
+#define FESD_SYSTEM_H
+
+#include "fesd/model.h"
+#include "fesd_rk.h"
+
+typedef struct {
+  int N, s, nx, nth, nsys, nu, bp;
+  fesd_tableau tab;
+  fesd__model *model;
+  /* variable layout */
+  int sb, n;
+  int *el, *xo, *ho, *lbo;
+  /* row layout */
+  int rs; /* rows per stage */
+  int *rel, *rlb, *rx;
+  int rH0, rC0, rT, n_eq, n_pair, n_raw;
+  /* pattern */
+  int nnz;
+  int *prow, *pcol;
+  /* parameters of the current step */
+  const double *x0, *u, *lam00;
+  double T;
+  int want_u; /* evaluate u-derivatives (sensitivities) */
+  /* scratch: evaluations at N*s stage points and N boundary points */
+  fesd__point_eval *pe;
+  double *X;    /* stage states, (N*s + N) x nx */
+  double *Jth;  /* sum_i theta_i dF_i/dx per stage point, N*s blocks nx x nx */
+  double *Juth; /* sum_i theta_i dF_i/du per stage point, N*s blocks nx x nu */
+  double *lam00_dp; /* d lambda00 / d(x_start, u): nth x (nx + nu) */
+  double *tmp;  /* nx + nth */
+  int status;   /* last model status */
+} fesd__system;
+
+int fesd__system_init(fesd__system *S, fesd__model *m, const fesd_tableau *tab, int N);
+void fesd__system_free(fesd__system *S);
+
+/* Offsets. */
+static inline int fesd__v(const fesd__system *S, int n, int j) { return S->el[n] + j * S->sb; }
+static inline int fesd__th(const fesd__system *S, int n, int j) { return S->el[n] + j * S->sb + S->nx; }
+static inline int fesd__la(const fesd__system *S, int n, int j) {
+  return S->el[n] + j * S->sb + S->nx + S->nth;
+}
+static inline int fesd__mu(const fesd__system *S, int n, int j) {
+  return S->el[n] + j * S->sb + S->nx + 2 * S->nth;
+}
+static inline int fesd__rowH(const fesd__system *S, int k) { return S->rH0 + k - 1; }
+static inline int fesd__rowC(const fesd__system *S, int k) { return S->rC0 + k - 1; }
+static inline int fesd__pair(const fesd__system *S, int n, int j, int i) {
+  return (n * S->s + j) * S->nth + i;
+}
+/* Right-boundary lambda of element n as a pointer into z (NULL if none in z:
+ * last element of a boundary-point method). */
+const double *fesd__right_lambda(const fesd__system *S, const double *z, int n);
+/* Left-boundary lambda of element n (lambda00 for n == 0). */
+const double *fesd__left_lambda(const fesd__system *S, const double *z, int n);
+
+/* ncp callback: raw residual and Jacobian values (ctx = fesd__system). */
+int fesd__system_eval(const double *z, double *raw, double *jac, void *ctx);
+
+/* Raw-row derivatives w.r.t. (x_start, u) at z (after an eval with want_u set):
+ * out is n_raw x (nx + nu), column-major, zeroed here. */
+int fesd__system_param_jac(fesd__system *S, const double *z, double *out);
+
+/* Compact cross-complementarity value of element n at z. */
+double fesd__cross_value(const fesd__system *S, const double *z, int n);
+
+#endif

@@ -1,0 +1,224 @@
+#include "problems/problems.h"
+
+#include <math.h>
+#include <string.h>
+
+static const int one_sys_two_modes[1] = {2};
+static const int one_switch[1] = {1};
+#define PI 3.14159265358979323846
+static const double W = 2.0 * PI;
+
+/* ---- oscillator (paper Sec. 4.4): mode 0 = c > 0 (outside): A1 x, mode 1 = c < 0: A2 x ---- */
+static int osc_field(int sys, int mode, const double *x, const double *u, double *f, void *user) {
+  (void)sys, (void)u, (void)user;
+  double s = mode == 0 ? 1.0 : -1.0; /* A1 = [[1, w], [-w, 1]], A2 = [[1, -w], [w, 1]] */
+  f[0] = x[0] + s * W * x[1];
+  f[1] = -s * W * x[0] + x[1];
+  return 0;
+}
+static int osc_field_jac(int sys, int mode, const double *x, const double *u, double *J, double *Ju,
+                         void *user) {
+  (void)sys, (void)x, (void)u, (void)Ju, (void)user;
+  double s = mode == 0 ? 1.0 : -1.0;
+  J[0] = 1;
+  J[1] = -s * W;
+  J[2] = s * W;
+  J[3] = 1;
+  return 0;
+}
+static int osc_sw(int sys, const double *x, const double *u, double *c, void *user) {
+  (void)sys, (void)u, (void)user;
+  c[0] = x[0] * x[0] + x[1] * x[1] - 1.0;
+  return 0;
+}
+static int osc_sw_jac(int sys, const double *x, const double *u, double *J, double *Ju, void *user) {
+  (void)sys, (void)u, (void)Ju, (void)user;
+  J[0] = 2 * x[0];
+  J[1] = 2 * x[1];
+  return 0;
+}
+int fesd_problem_oscillator_exact(double t, double *x) {
+  double a = exp(t - 1.0);
+  if (t <= 1.0) {
+    x[0] = a * cos(W * t);
+    x[1] = a * sin(W * t);
+  } else {
+    x[0] = a * cos(W * (t - 1.0));
+    x[1] = -a * sin(W * (t - 1.0));
+  }
+  return 0;
+}
+
+/* ---- scalar sign examples: c = x, mode 0 = x > 0, mode 1 = x < 0 ---- */
+typedef struct {
+  double f_pos, f_neg, t_coef, x2_coef;
+} scalar_law;
+/* f_mode(x, t) = f + t_coef * t + x2_coef * x^2; time enters as state x[1] (x[1]' = 1) */
+static const scalar_law law_a = {1, 3, 0, 0};  /* 2 - sign(x) */
+static const scalar_law law_b = {-1, 1, 0, 0}; /* -sign(x) */
+static const scalar_law law_c = {-1, 1, 1, 0}; /* -sign(x) + t */
+static const scalar_law law_d = {1, -1, 0, 0}; /* sign(x) */
+static const scalar_law law_nl = {1, 3, 0, 1}; /* 2 - sign(x) + x^2 */
+
+static int scalar_field(int sys, int mode, const double *x, const double *u, double *f, void *user) {
+  (void)sys, (void)u;
+  const scalar_law *L = user;
+  f[0] = (mode == 0 ? L->f_pos : L->f_neg) + L->t_coef * x[1] + L->x2_coef * x[0] * x[0];
+  f[1] = 1.0;
+  return 0;
+}
+static int scalar_field_jac(int sys, int mode, const double *x, const double *u, double *J,
+                            double *Ju, void *user) {
+  (void)sys, (void)mode, (void)u, (void)Ju;
+  const scalar_law *L = user;
+  J[0] = 2 * L->x2_coef * x[0];
+  J[1] = 0;
+  J[2] = L->t_coef;
+  J[3] = 0;
+  return 0;
+}
+static int scalar_sw(int sys, const double *x, const double *u, double *c, void *user) {
+  (void)sys, (void)u, (void)user;
+  c[0] = x[0];
+  return 0;
+}
+static int scalar_sw_jac(int sys, const double *x, const double *u, double *J, double *Ju, void *user) {
+  (void)sys, (void)x, (void)u, (void)Ju, (void)user;
+  J[0] = 1;
+  J[1] = 0;
+  return 0;
+}
+static int exact_a(double t, double *x) {
+  x[0] = t <= 1.0 / 3 ? -1 + 3 * t : t - 1.0 / 3;
+  x[1] = t;
+  return 0;
+}
+static int exact_b(double t, double *x) {
+  x[0] = t <= 1 ? 1 - t : 0;
+  x[1] = t;
+  return 0;
+}
+static int exact_c(double t, double *x) {
+  x[0] = t <= 1 ? 0 : 0.5 * (t - 1) * (t - 1);
+  x[1] = t;
+  return 0;
+}
+
+/* ---- ocp-dynamics (paper Sec. 5): q' = -sign(c(q)) + v, v' = u, two subsystems ---- */
+static const int two_sys_modes[2] = {2, 2};
+static const int two_sys_switch[2] = {1, 1};
+static int ocp_field(int sys, int mode, const double *x, const double *u, double *f, void *user) {
+  (void)user;
+  double sg = mode == 0 ? -1.0 : 1.0; /* mode 0: c_k > 0 -> -sign = -1 */
+  if (sys == 0) {
+    f[0] = sg + x[2];
+    f[1] = x[3];
+    f[2] = u[0];
+    f[3] = u[1];
+  } else {
+    f[0] = 0;
+    f[1] = sg;
+    f[2] = 0;
+    f[3] = 0;
+  }
+  return 0;
+}
+static int ocp_field_jac(int sys, int mode, const double *x, const double *u, double *J, double *Ju,
+                         void *user) {
+  (void)mode, (void)x, (void)u, (void)user;
+  memset(J, 0, 16 * sizeof(double));
+  if (Ju) memset(Ju, 0, 8 * sizeof(double));
+  if (sys == 0) {
+    J[2 * 4 + 0] = 1; /* df0/dx2 */
+    J[3 * 4 + 1] = 1; /* df1/dx3 */
+    if (Ju) {
+      Ju[0 * 4 + 2] = 1;
+      Ju[1 * 4 + 3] = 1;
+    }
+  }
+  return 0;
+}
+static int ocp_sw(int sys, const double *x, const double *u, double *c, void *user) {
+  (void)u, (void)user;
+  c[0] = sys == 0 ? x[0] + 0.15 * x[1] * x[1] : -0.05 * x[0] * x[0] * x[0] + x[1];
+  return 0;
+}
+static int ocp_sw_jac(int sys, const double *x, const double *u, double *J, double *Ju, void *user) {
+  (void)u, (void)user;
+  if (sys == 0) {
+    J[0] = 1;
+    J[1] = 0.3 * x[1];
+  } else {
+    J[0] = -0.15 * x[0] * x[0];
+    J[1] = 1;
+  }
+  J[2] = J[3] = 0;
+  if (Ju) Ju[0] = Ju[1] = 0;
+  return 0;
+}
+
+static const char *const names[] = {"oscillator", "sign-a", "sign-b", "sign-c", "sign-d",
+                                    "nonlipschitz", "ocp-dynamics", NULL};
+
+const char *const *fesd_problem_names(void) { return names; }
+
+static void scalar_problem(fesd_problem *p, const scalar_law *law, double x0, double T) {
+  p->model = (fesd_model){2, 0, 1, one_sys_two_modes, one_switch, NULL, scalar_field,
+                          scalar_field_jac, scalar_sw, scalar_sw_jac, (void *)law};
+  p->x0[0] = x0;
+  p->x0[1] = 0;
+  p->T = T;
+}
+
+int fesd_problem_get(const char *name, fesd_problem *p) {
+  if (!name || !p) return FESD_ERR_NULL;
+  memset(p, 0, sizeof(*p));
+  p->t_switch = NAN;
+  if (!strcmp(name, "oscillator")) {
+    p->name = "oscillator";
+    p->description = "x' = A1 x outside / A2 x inside the unit circle; crossing at t = 1";
+    p->model = (fesd_model){2, 0, 1, one_sys_two_modes, one_switch, NULL, osc_field, osc_field_jac,
+                            osc_sw, osc_sw_jac, NULL};
+    p->x0[0] = exp(-1.0);
+    p->T = PI / 2;
+    p->t_switch = 1.0;
+    p->exact = fesd_problem_oscillator_exact;
+  } else if (!strcmp(name, "sign-a")) {
+    p->name = "sign-a";
+    p->description = "x' in 2 - sign(x), x0 = -1: crossing at t = 1/3";
+    scalar_problem(p, &law_a, -1.0, 1.0);
+    p->t_switch = 1.0 / 3;
+    p->exact = exact_a;
+  } else if (!strcmp(name, "sign-b")) {
+    p->name = "sign-b";
+    p->description = "x' in -sign(x), x0 = 1: reaches 0 at t = 1 and slides";
+    scalar_problem(p, &law_b, 1.0, 2.1);
+    p->t_switch = 1.0;
+    p->exact = exact_b;
+  } else if (!strcmp(name, "sign-c")) {
+    p->name = "sign-c";
+    p->description = "x' in -sign(x) + t, x0 = 0: slides until t = 1, then x = (t-1)^2/2";
+    scalar_problem(p, &law_c, 0.0, 2.1);
+    p->t_switch = 1.0;
+    p->exact = exact_c;
+  } else if (!strcmp(name, "sign-d")) {
+    p->name = "sign-d";
+    p->description = "x' in sign(x), x0 = 0: non-unique (any Filippov solution)";
+    scalar_problem(p, &law_d, 0.0, 1.0);
+  } else if (!strcmp(name, "nonlipschitz")) {
+    p->name = "nonlipschitz";
+    p->description = "x' in 2 - sign(x) + x^2, x0 = -0.2, T = 0.2";
+    scalar_problem(p, &law_nl, -0.2, 0.2);
+  } else if (!strcmp(name, "ocp-dynamics")) {
+    p->name = "ocp-dynamics";
+    p->description = "q' = -sign(c(q)) + v, v' = u = 0: sliding on c1 = 0, then on c = 0";
+    p->model = (fesd_model){4, 2, 2, two_sys_modes, two_sys_switch, NULL, ocp_field, ocp_field_jac,
+                            ocp_sw, ocp_sw_jac, NULL};
+    p->x0[0] = 2 * PI / 3;
+    p->x0[1] = PI / 3;
+    p->T = 4.0;
+  } else {
+    return FESD_ERR_INVALID_ARG;
+  }
+  return FESD_OK;
+}
