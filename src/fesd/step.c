@@ -12,7 +12,11 @@
  *      elsewhere, and sum h = T; sigma-homotopy as fallback;
  *  (d) verify (all sparse cross products, h > 0); on failure the caller halves the step. */
 #include <math.h>
+#include <stdio.h>
+#define DBG(...) do { if (getenv("FESD_DBG")) fprintf(stderr, __VA_ARGS__); } while (0)
+static void dbglog(void *u, const char *m) { (void)u; fprintf(stderr, "      %s\n", m); }
 #include <string.h>
+#include <stdlib.h>
 
 #include "common/timer.h"
 #include "fesd/integrator.h"
@@ -56,6 +60,7 @@ static void accumulate(fesd_step_info *info, const fesd_ncp_info *ni) {
 static int solve(fesd_integrator *it, double *z, double sigma, double tol, int max_iter,
                  int homotopy, fesd_step_info *info) {
   fesd_ncp_settings ns = it->set.ncp;
+  if (getenv("FESD_DBG") && !homotopy && sigma == 0 && max_iter == it->set.max_iter) ns.log = dbglog;
   ns.tol = tol;
   ns.max_iter = max_iter;
   fesd_ncp_update_settings(it->ncp, &ns);
@@ -209,6 +214,7 @@ static int predict_switches(fesd_integrator *it, const double *z, double T, doub
   }
   sw_event ev[64];
   int ne = 0;
+
   for (int i = 0; i < nth; i++) {
     int last = -1;
     for (int p = 0; p < np; p++) {
@@ -233,7 +239,7 @@ static int predict_switches(fesd_integrator *it, const double *z, double T, doub
       ev[b - 1] = tmp;
     }
   int nc = 0;
-  double merge = 0.5 * T / S->N;
+  double merge = T / S->N;
   for (int a = 0; a < ne;) {
     int b = a;
     double sum = 0;
@@ -283,7 +289,9 @@ static void resort_guess(fesd_integrator *it, const double *zsrc, double T, cons
     double t_lo = c == 0 ? 0 : tc[c - 1], t_hi = c == nc ? T : tc[c];
     double h = (t_hi - t_lo) / (n_hi - n_lo);
     for (int n = n_lo; n < n_hi; n++) {
-      double tm = t_lo + (n - n_lo + 0.5) * h;
+      /* the purest values lie farthest from the switches: the earliest point before the
+       * first switch, the latest after the last one, the middle in between */
+      double tm = c == 0 ? -INFINITY : c == nc ? INFINITY : t_lo + (n - n_lo + 0.5) * h;
       const double *blk = source_block(it, zsrc, np, t_lo, t_hi, tm);
       if (!blk) {
         if (c == 0 && it->have_ws)
@@ -464,6 +472,7 @@ static int try_step(fesd_integrator *it, const double *u, double T, fesd_step_in
   if ((st = rows_select(it, NULL))) return st;
   memcpy(z, z0, (size_t)S->n * sizeof(double));
   st = solve(it, z, 0.0, tol, it->set.max_iter_first, 0, info);
+  DBG("t=%.4f T=%.4f std st=%d it=%d\n", it->t, T, st, info->newton_iter);
   if (st == FESD_ERR_CALLBACK) return st;
   if (it->set.method == FESD_METHOD_STANDARD) {
     if (st != FESD_OK) {
@@ -495,12 +504,15 @@ static int try_step(fesd_integrator *it, const double *u, double T, fesd_step_in
   }
   double tc[16];
   int nc = predict_switches(it, zp, T, tc, 16);
+  DBG("  predictor from %s: nc=%d tc0=%.6f (abs %.6f)\n", st==FESD_OK?"std":"smoothed", nc, nc?tc[0]:-1, nc?it->t+tc[0]:-1);
   if (nc == 0 || nc > S->N - 1) return FESD_ERR_TOO_MANY_SWITCHES;
   /* (c) reduced square FESD system */
   resort_guess(it, zp, T, tc, nc, it->sw_at, z0);
   if ((st = rows_select(it, it->sw_at))) return st;
   memcpy(z, z0, (size_t)S->n * sizeof(double));
+  { fesd_ncp_settings ns = it->set.ncp; ns.log = dbglog; fesd_ncp_update_settings(it->ncp, &ns); }
   st = solve(it, z, 0.0, tol, it->set.max_iter, 0, info);
+  DBG("  reduced st=%d valid=%d cc=%.2e h0=%.6f h1=%.6f it=%d\n", st, st==0?fesd_valid(it,z,&ccm):-1, ccm, z[S->ho[0]], z[S->ho[1]], info->newton_iter);
   if (st == FESD_ERR_CALLBACK) return st;
   if (st != FESD_OK || !fesd_valid(it, z, &ccm)) {
     memcpy(z, z0, (size_t)S->n * sizeof(double));
