@@ -16,9 +16,10 @@
  * Row selection. Per solve, smooth rows can be switched off and pairs can be
  * put in PIN mode, where the pair contributes the two rows a_k = 0 and b_k = 0
  * instead of its FB row (used by FESD at a sliding exit). The assembled system
- * has m = (#active eq rows) + (#FB pairs) + 2 (#PIN pairs) rows, in this order:
- * active eq rows by increasing index, then for k = 0..n_pair-1 the FB row of k
- * (FB mode) or the rows a_k, b_k (PIN mode); OFF pairs contribute nothing.
+ * has m = (#active eq rows) + (#FB, A and B pairs) + 2 (#PIN pairs) rows, in this
+ * order: active eq rows by increasing index, then for k = 0..n_pair-1 the FB row of
+ * k (FB mode), the rows a_k, b_k (PIN), the row a_k (A) or the row b_k (B); OFF
+ * pairs contribute nothing.
  *   m == n : square semismooth Newton with Armijo line search on 1/2||F||^2
  *            (gradient step fallback when the Newton direction is not a descent
  *            direction).
@@ -50,8 +51,16 @@ typedef enum {
   FESD_NCP_BACKEND_CHOLMOD = 4  /**< LM normal equations J'J + mu I, analysis reused */
 } fesd_ncp_backend;
 
-/** Pair modes for fesd_ncp_set_rows(). */
-enum { FESD_NCP_PAIR_FB = 0, FESD_NCP_PAIR_PIN = 1, FESD_NCP_PAIR_OFF = 2 };
+/** Pair modes for fesd_ncp_set_rows(): FB row (default); PIN: the two rows a = 0, b = 0;
+ *  OFF: no row; A: the row a = 0 (pair known inactive on the a side); B: the row b = 0.
+ *  A and B fix an active set: the system is then smooth. */
+enum {
+  FESD_NCP_PAIR_FB = 0,
+  FESD_NCP_PAIR_PIN = 1,
+  FESD_NCP_PAIR_OFF = 2,
+  FESD_NCP_PAIR_A = 3,
+  FESD_NCP_PAIR_B = 4
+};
 
 /**
  * Raw residual/Jacobian callback.

@@ -45,7 +45,7 @@ void fesd_free(fesd_integrator **itp) {
   double *bufs[] = {it->x, it->lam00, it->theta_prev, it->u_cur, it->z, it->zws, it->z0, it->zpred,
                     it->raw, it->jac, it->lb, it->ub, it->bk_x, it->bk_lam, it->bk_th, it->bk_zws,
                     it->bk_Sx, it->bk_Su, it->bk_ldp, it->Sx, it->Su, it->draw, it->dz, it->Dtmp,
-                    it->Stmp, it->gbuf, it->blk, it->pt_t, it->pt_q, it->rec_h, it->rec_t,
+                    it->Stmp, it->gbuf, it->blk, it->pt_t, it->pt_q, it->pt_l, it->rec_h, it->rec_t,
                     it->rec_x, it->rec_th, it->rec_la, it->rec_mu};
   for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); i++) free(bufs[i]);
   free(it->eq_active);
@@ -53,6 +53,12 @@ void fesd_free(fesd_integrator **itp) {
   free(it->pt_src);
   free(it->kb);
   free(it->sw_at);
+  free(it->act);
+  free(it->act0);
+  free(it->cand);
+  free(it->bmode);
+  free(it->exit_mode);
+  free(it->zfast);
   free(it);
   *itp = NULL;
 }
@@ -129,8 +135,9 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   it->Stmp = dalloc(nx * (nx > nu ? nx : nu), &fail);
   it->gbuf = dalloc(nth + nx, &fail);
   it->blk = dalloc((size_t)S->sb, &fail);
-  it->pt_t = dalloc(N * s + 1, &fail);
-  it->pt_q = dalloc((N * s + 1) * nth, &fail);
+  it->pt_t = dalloc(N * (s + 1) + 1, &fail);
+  it->pt_q = dalloc((N * (s + 1) + 1) * nth, &fail);
+  it->pt_l = dalloc((N * (s + 1) + 1) * nth, &fail);
   it->cap_el = (int)N << settings->max_splits;
   size_t cap = (size_t)it->cap_el;
   it->rec_h = dalloc(cap, &fail);
@@ -141,10 +148,17 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   it->rec_mu = dalloc(cap * s * (size_t)it->nsys, &fail);
   it->eq_active = malloc((size_t)S->n_eq);
   it->pair_mode = malloc((size_t)(S->n_pair > 0 ? S->n_pair : 1));
-  it->pt_src = malloc((N * s + 1) * sizeof(int));
+  it->pt_src = malloc((N * (s + 1) + 1) * sizeof(int));
   it->kb = malloc((N + 1) * sizeof(int));
   it->sw_at = malloc((N + 1) * sizeof(int));
-  if (fail || !it->eq_active || !it->pair_mode || !it->pt_src || !it->kb || !it->sw_at) {
+  it->act = malloc(N * nth);
+  it->act0 = malloc(nth);
+  it->cand = malloc(nth);
+  it->bmode = calloc(N + 1, sizeof(int));
+  it->exit_mode = calloc(N + 1, sizeof(int));
+  it->zfast = dalloc(n, &fail);
+  if (fail || !it->eq_active || !it->pair_mode || !it->pt_src || !it->kb || !it->sw_at || !it->act ||
+      !it->act0 || !it->cand || !it->bmode || !it->exit_mode) {
     fesd_free(&it);
     return FESD_ERR_NOMEM;
   }

@@ -27,8 +27,12 @@ struct fesd_integrator {
   /* sensitivities */
   double *Sx, *Su, *draw, *dz, *Dtmp, *Stmp;
   double *gbuf, *blk;
-  double *pt_t, *pt_q; /* switch prediction: point times and q values */
+  double *pt_t, *pt_q, *pt_l; /* switch prediction: point times and q values */
   int *pt_src, *kb, *sw_at;
+  /* active-set path */
+  unsigned char *act, *act0, *cand;
+  int *bmode, *exit_mode;
+  double *zfast;
   /* records of the last accepted step */
   int cap_el, n_el;
   double *rec_h, *rec_t, *rec_x, *rec_th, *rec_la, *rec_mu;

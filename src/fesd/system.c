@@ -241,7 +241,7 @@ int fesd__system_init(fesd__system *S, fesd__model *m, const fesd_tableau *tab, 
     S->rel[n] = row;
     off += s * S->sb;
     row += s * S->rs;
-    if (S->bp && n < N - 1) {
+    if (S->bp) {
       S->lbo[n] = off;
       S->rlb[n] = row;
       off += nth + nsys;

@@ -4,9 +4,11 @@
  *
  * Unknowns, element by element: for each stage j: v (nx), theta (nth),
  * lambda (nth), mu (nsys); for methods whose last stage is not the element end
- * (not stiffly accurate: Gauss-Legendre, explicit RK) and n < N-1 the boundary
- * LP values LB (nth), MB (nsys) at x_{n+1} (paper Sec. 3.2.5 / 4.2.1); then
- * x_{n+1} (nx) and h_n.
+ * (not stiffly accurate: Gauss-Legendre, explicit RK) the boundary LP values
+ * LB (nth), MB (nsys) at x_{n+1} (paper Sec. 3.2.5 / 4.2.1). Unlike the paper we
+ * keep them for the last element too: a switch between the last stage and the
+ * step end would otherwise go unseen (the step end is an element boundary of
+ * the integration as a whole). Then x_{n+1} (nx) and h_n.
  * Smooth rows, element by element: per stage  v - F(X) theta,  g(X) - lambda - mu e,
  * 1 - e'theta  (per subsystem); boundary LP rows  g(x_{n+1}) - LB - MB e  and
  * theta_{n,s}' LB = 0 (per subsystem: fixes MB as the indicator of the active

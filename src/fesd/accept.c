@@ -1,0 +1,152 @@
+/* Acceptance of a converged step: sensitivities by the implicit function theorem,
+ * element records, event classification and the state update. */
+#include <math.h>
+#include <string.h>
+
+#include "fesd/step.h"
+
+/* lambda00 = g(x) - min g e per subsystem, and (when sensitivities are on) its derivative
+ * w.r.t. (x, u) using the argmin (ties: the mode with the largest theta_prev). */
+int fesd__update_lambda00(fesd_integrator *it, const double *x, const double *u, int deriv) {
+  fesd__model *m = &it->model;
+  const int nx = m->nx, nu = m->nu, nth = m->nth;
+  fesd__point_eval pe = {0};
+  pe.g = it->gbuf;
+  double *dg = it->sys.lam00_dp; /* nth x (nx+nu) column-major */
+  double *dgdx = it->Dtmp, *dgdu = it->Dtmp + (size_t)nth * nx;
+  if (deriv) {
+    pe.dgdx = dgdx;
+    pe.dgdu = nu > 0 ? dgdu : NULL;
+  }
+  int st = fesd__model_eval(m, x, u, &pe);
+  if (st) return st;
+  for (int k = 0; k < m->nsys; k++) {
+    int imin = m->th_off[k];
+    for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) {
+      double tie = 1e-12 * fmax(1.0, fabs(it->gbuf[imin]));
+      if (it->gbuf[i] < it->gbuf[imin] - tie ||
+          (fabs(it->gbuf[i] - it->gbuf[imin]) <= tie && it->have_prev_theta &&
+           it->theta_prev[i] > it->theta_prev[imin]))
+        imin = i;
+    }
+    double gmin = it->gbuf[imin];
+    for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) {
+      it->lam00[i] = fmax(it->gbuf[i] - gmin, 0.0);
+      if (deriv) {
+        for (int c = 0; c < nx; c++) dg[c * nth + i] = dgdx[c * nth + i] - dgdx[c * nth + imin];
+        for (int c = 0; c < nu; c++)
+          dg[(nx + c) * nth + i] = dgdu[c * nth + i] - dgdu[c * nth + imin];
+      }
+    }
+  }
+  return FESD_OK;
+}
+
+/* dx_end/d(x_start, u) of the accepted step by the implicit function theorem, chained into
+ * Sx, Su. */
+static int chain_sensitivities(fesd_integrator *it, const double *z) {
+  fesd__system *S = &it->sys;
+  const int nx = it->nx, nu = it->nu, np = nx + nu;
+  S->want_u = 1;
+  int st = fesd__system_eval(z, it->raw, it->jac, S);
+  if (st) {
+    S->want_u = 0;
+    return S->status ? S->status : FESD_ERR_CALLBACK;
+  }
+  fesd__system_param_jac(S, z, it->draw);
+  S->want_u = 0;
+  st = fesd_ncp_sensitivity(it->ncp, z, 0.0, np, it->draw, it->dz);
+  if (st) return st;
+  /* D = rows of x_N in dz: nx x np */
+  const int xN = S->xo[S->N - 1];
+  double *D = it->Dtmp;
+  for (int c = 0; c < np; c++)
+    for (int r = 0; r < nx; r++) D[c * nx + r] = it->dz[(size_t)c * S->n + xN + r];
+  /* Sx <- Dx Sx ; Su <- Dx Su + Du */
+  double *T = it->Stmp;
+  for (int c = 0; c < nx; c++)
+    for (int r = 0; r < nx; r++) {
+      double acc = 0;
+      for (int q = 0; q < nx; q++) acc += D[q * nx + r] * it->Sx[c * nx + q];
+      T[c * nx + r] = acc;
+    }
+  memcpy(it->Sx, T, (size_t)nx * nx * sizeof(double));
+  for (int c = 0; c < nu; c++)
+    for (int r = 0; r < nx; r++) {
+      double acc = D[(nx + c) * nx + r];
+      for (int q = 0; q < nx; q++) acc += D[q * nx + r] * it->Su[c * nx + q];
+      T[c * nx + r] = acc;
+    }
+  if (nu > 0) memcpy(it->Su, T, (size_t)nx * nu * sizeof(double));
+  return FESD_OK;
+}
+
+static unsigned active_bits(const fesd_integrator *it, const double *th, int k) {
+  unsigned bits = 0;
+  const fesd__model *m = &it->model;
+  for (int i = m->th_off[k]; i < m->th_off[k + 1] && i - m->th_off[k] < 32; i++)
+    if (th[i] > it->set.active_tol) bits |= 1u << (i - m->th_off[k]);
+  return bits;
+}
+
+/* Active modes of element n of z (theta above active_tol at any stage). */
+static unsigned element_bits(const fesd_integrator *it, const double *z, int n, int k) {
+  unsigned bits = 0;
+  for (int j = 0; j < it->s; j++) bits |= active_bits(it, z + fesd__th(&it->sys, n, j), k);
+  return bits;
+}
+
+static void add_event(fesd_integrator *it, double t, int k, unsigned before, unsigned after) {
+  if (before == after || it->n_events >= FESD_MAX_EVENTS_PER_STEP) return;
+  fesd_event *e = &it->events[it->n_events++];
+  e->t = t;
+  e->sys = k;
+  e->before = before;
+  e->after = after;
+  if ((after & before) == before)
+    e->kind = FESD_EVENT_SLIDING_ENTRY;
+  else if ((after & before) == after)
+    e->kind = FESD_EVENT_SLIDING_EXIT;
+  else
+    e->kind = FESD_EVENT_CROSSING;
+}
+
+int fesd__accept(fesd_integrator *it, const double *z, const double *u, double T) {
+  fesd__system *S = &it->sys;
+  const int N = S->N, s = S->s, nx = it->nx, nth = it->nth, nsys = it->nsys;
+  int st;
+  if (it->set.sensitivities && (st = chain_sensitivities(it, z))) return st;
+  /* records */
+  double t = it->t;
+  for (int n = 0; n < N && it->n_el < it->cap_el; n++) {
+    int e = it->n_el++;
+    it->rec_h[e] = z[S->ho[n]];
+    it->rec_t[e] = t;
+    memcpy(it->rec_x + (size_t)e * nx, n == 0 ? S->x0 : z + S->xo[n - 1], (size_t)nx * sizeof(double));
+    for (int j = 0; j < s; j++) {
+      memcpy(it->rec_th + ((size_t)e * s + j) * nth, z + fesd__th(S, n, j), (size_t)nth * sizeof(double));
+      memcpy(it->rec_la + ((size_t)e * s + j) * nth, z + fesd__la(S, n, j), (size_t)nth * sizeof(double));
+      memcpy(it->rec_mu + ((size_t)e * s + j) * nsys, z + fesd__mu(S, n, j), (size_t)nsys * sizeof(double));
+    }
+    /* events at the left boundary of element n */
+    for (int k = 0; k < nsys; k++) {
+      unsigned before = n == 0 ? (it->have_prev_theta ? active_bits(it, it->theta_prev, k) : 0)
+                               : element_bits(it, z, n - 1, k);
+      if (n == 0 && !it->have_prev_theta) continue;
+      add_event(it, t, k, before, element_bits(it, z, n, k));
+    }
+    t += z[S->ho[n]];
+  }
+  it->rec_t[it->n_el] = it->t + T;
+  memcpy(it->rec_x + (size_t)it->n_el * nx, z + S->xo[N - 1], (size_t)nx * sizeof(double));
+  /* state */
+  it->t += T;
+  memcpy(it->x, z + S->xo[N - 1], (size_t)nx * sizeof(double));
+  memcpy(it->theta_prev, z + fesd__th(S, N - 1, s - 1), (size_t)nth * sizeof(double));
+  it->have_prev_theta = 1;
+  if ((st = fesd__update_lambda00(it, it->x, u, it->set.sensitivities))) return st;
+  memcpy(it->zws, z, (size_t)S->n * sizeof(double));
+  it->have_ws = 1;
+  return FESD_OK;
+}
+

@@ -1,0 +1,152 @@
+/* Active-set path of the step solve. With the active set of every element fixed
+ * (pair rows theta_i = 0 for inactive modes, lambda_i = 0 for active ones) the step
+ * system is smooth and Newton converges quadratically; the complementarity signs are
+ * then verified (theta >= 0 on active modes, lambda >= 0 on inactive ones). A violated
+ * sign locates the next switch accurately: lambda of an inactive mode is a smooth
+ * difference of indicators along the computed trajectory, theta of an active mode a
+ * smooth sliding multiplier; their linear zero crossing predicts the switch time. */
+#include <math.h>
+#include <string.h>
+
+#include "fesd/step.h"
+
+/* Active modes of one theta vector (theta > active_tol); every subsystem keeps at least
+ * its largest mode. */
+void fesd__act_from_theta(const fesd_integrator *it, const double *theta, unsigned char *a) {
+  const fesd__model *m = &it->model;
+  for (int k = 0; k < m->nsys; k++) {
+    int best = m->th_off[k], any = 0;
+    for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) {
+      a[i] = theta[i] > it->set.active_tol;
+      any |= a[i];
+      if (theta[i] > theta[best]) best = i;
+    }
+    if (!any) a[best] = 1;
+  }
+}
+
+/* Active set at the step start: the previous step's last stage, or the argmin of g. */
+int fesd__act_start(fesd_integrator *it, const double *u, unsigned char *a) {
+  if (it->have_prev_theta) {
+    fesd__act_from_theta(it, it->theta_prev, a);
+    return FESD_OK;
+  }
+  fesd__model *m = &it->model;
+  int st = fesd__model_g(m, it->x, u, it->gbuf);
+  if (st) return st;
+  for (int k = 0; k < m->nsys; k++) {
+    double gmin = INFINITY;
+    for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) gmin = fmin(gmin, it->gbuf[i]);
+    double tie = 1e-12 * fmax(1.0, fabs(gmin));
+    for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) a[i] = it->gbuf[i] <= gmin + tie;
+  }
+  return FESD_OK;
+}
+
+/* theta restricted to the active set of each element (renormalised per subsystem,
+ * uniform where the guess had no weight on the active modes). */
+void fesd__impose_active(fesd_integrator *it, double *z, const unsigned char *act) {
+  fesd__system *S = &it->sys;
+  const fesd__model *m = &it->model;
+  for (int n = 0; n < S->N; n++) {
+    const unsigned char *a = act + (size_t)n * S->nth;
+    for (int j = 0; j < S->s; j++) {
+      double *th = z + fesd__th(S, n, j);
+      for (int k = 0; k < m->nsys; k++) {
+        double sum = 0;
+        int cnt = 0;
+        for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) {
+          if (!a[i]) th[i] = 0;
+          else {
+            th[i] = fmax(th[i], 0.0);
+            sum += th[i];
+            cnt++;
+          }
+        }
+        for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++)
+          if (a[i]) th[i] = sum > 1e-3 ? th[i] / sum : 1.0 / cnt;
+      }
+    }
+  }
+}
+
+/* Rows for fixed active sets: pairs A (theta = 0) or B (lambda = 0) per element;
+ * boundary k: bmode[k] = 0 -> h_k = h_{k-1}; 1 -> cross-complementarity row;
+ * 2 -> sliding exit of mode exit_mode[k]: the pair of its last stage before the boundary
+ * is pinned (theta = lambda = 0) and neither boundary row is used. */
+int fesd__rows_active(fesd_integrator *it, const unsigned char *act, const int *bmode,
+                      const int *exit_mode) {
+  fesd__system *S = &it->sys;
+  memset(it->eq_active, 1, (size_t)S->n_eq);
+  for (int k = 1; k < S->N; k++) {
+    int b = bmode ? bmode[k] : 0;
+    it->eq_active[fesd__rowH(S, k)] = (unsigned char)(b == 0);
+    it->eq_active[fesd__rowC(S, k)] = (unsigned char)(b == 1);
+  }
+  for (int n = 0; n < S->N; n++)
+    for (int j = 0; j < S->s; j++)
+      for (int i = 0; i < S->nth; i++)
+        it->pair_mode[fesd__pair(S, n, j, i)] =
+            act[(size_t)n * S->nth + i] ? FESD_NCP_PAIR_B : FESD_NCP_PAIR_A;
+  for (int k = 1; k < S->N; k++)
+    if (bmode && bmode[k] == 2) it->pair_mode[fesd__pair(S, k - 1, S->s - 1, exit_mode[k])] = FESD_NCP_PAIR_PIN;
+  return fesd_ncp_set_rows(it->ncp, it->eq_active, it->pair_mode);
+}
+
+/* Earliest sign violation of the fixed active sets in z, scanning the step start and the
+ * stage (and boundary LP) points in time order. */
+int fesd__find_violation(fesd_integrator *it, const double *z, const unsigned char *act,
+                         fesd__violation *v) {
+  fesd__system *S = &it->sys;
+  const int nth = S->nth;
+  const double tol = it->set.cc_tol;
+  v->found = 0;
+  v->t = INFINITY;
+  for (int i = 0; i < nth; i++) {
+    double t0 = 0, v0 = NAN; /* last point value of the monitored quantity */
+    if (act[i])
+      v0 = it->have_prev_theta ? it->theta_prev[i] : 1.0;
+    else
+      v0 = it->lam00[i];
+    double tn = 0;
+    int done = 0;
+    for (int n = 0; n < S->N && !done; n++) {
+      const int a = act[(size_t)n * nth + i];
+      if (n > 0 && a != act[(size_t)(n - 1) * nth + i]) v0 = NAN; /* switch at this boundary */
+      double h = z[S->ho[n]];
+      for (int j = 0; j <= S->s; j++) {
+        double t, val;
+        if (j < S->s) {
+          /* Stage states at c_j = 0 (Lobatto, explicit RK) lie O(h^2) off the element start,
+           * and explicit stages are low-order predictions that can overshoot a surface the
+           * trajectory does not reach: their indicator signs are not switches. Explicit
+           * methods are checked at the element ends (boundary LP points) instead. */
+          if (S->tab.c[j] == 0.0 || (S->tab.is_explicit && !a)) continue;
+          t = tn + S->tab.c[j] * h;
+          val = a ? z[fesd__th(S, n, j) + i] : z[fesd__la(S, n, j) + i];
+        } else {
+          if (!S->bp || a) continue; /* boundary LP point: lambda of inactive modes */
+          t = tn + h;
+          val = z[S->lbo[n] + i];
+        }
+        if (val < -tol) {
+          double tc = isnan(v0) ? tn : (v0 > 0 ? t0 + (t - t0) * v0 / (v0 - val) : t0);
+          if (tc < v->t) {
+            v->found = 1;
+            v->t = tc;
+            v->mode = i;
+            v->sys = it->model.sys_of[i];
+            v->enter = !a;
+            v->element = n;
+          }
+          done = 1;
+          break;
+        }
+        t0 = t;
+        v0 = val;
+      }
+      tn += h;
+    }
+  }
+  return v->found;
+}

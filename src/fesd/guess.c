@@ -1,0 +1,126 @@
+/* Initial guesses of the step system: warm start from the previous step, the LP at
+ * the state for the first step, consistency sweeps, and the re-sorted guess around
+ * predicted switches (FB fallback path). */
+#include <math.h>
+#include <string.h>
+
+#include "fesd/step.h"
+
+/* Make a guess consistent with its theta and h: a few fixed-point sweeps
+ * v_j = F(X_j) theta_j with X_j = x_n + h sum_l a_jl v_l (exact for explicit methods after
+ * s sweeps), then lambda, mu from the LP rows with mu the theta-weighted indicator (so the
+ * modes that theta marks active get lambda = 0), x_{n+1} by the quadrature, and the boundary
+ * LP values. Only the rows that carry the switch (cross complementarity) stay inconsistent. */
+int fesd__consistent_guess(fesd_integrator *it, double *z) {
+  fesd__system *S = &it->sys;
+  fesd__model *m = &it->model;
+  const int nx = S->nx, nth = S->nth, s = S->s;
+  double *F = S->pe[0].F, *g = S->pe[0].g, *X = S->X;
+  fesd__point_eval pe = {0};
+  pe.F = F;
+  pe.g = g;
+  for (int n = 0; n < S->N; n++) {
+    const double *xn = n == 0 ? S->x0 : z + S->xo[n - 1];
+    double h = z[S->ho[n]];
+    for (int sweep = 0; sweep < (S->tab.is_explicit ? s : 3); sweep++)
+      for (int j = 0; j < s; j++) {
+        for (int r = 0; r < nx; r++) {
+          double acc = 0;
+          for (int l = 0; l < s; l++) acc += S->tab.A[j][l] * z[fesd__v(S, n, l) + r];
+          X[r] = xn[r] + h * acc;
+        }
+        int st = fesd__model_eval(m, X, S->u, &pe);
+        if (st) return st;
+        const double *th = z + fesd__th(S, n, j);
+        double *v = z + fesd__v(S, n, j), *la = z + fesd__la(S, n, j), *mu = z + fesd__mu(S, n, j);
+        for (int r = 0; r < nx; r++) {
+          double acc = 0;
+          for (int i = 0; i < nth; i++) acc += F[i * nx + r] * th[i];
+          v[r] = acc;
+        }
+        for (int k = 0; k < m->nsys; k++) {
+          double num = 0, den = 0;
+          for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) num += th[i] * g[i], den += th[i];
+          mu[k] = den > 0 ? num / den : g[m->th_off[k]];
+        }
+        for (int i = 0; i < nth; i++) la[i] = g[i] - mu[m->sys_of[i]];
+      }
+    for (int r = 0; r < nx; r++) {
+      double acc = 0;
+      for (int j = 0; j < s; j++) acc += S->tab.b[j] * z[fesd__v(S, n, j) + r];
+      z[S->xo[n] + r] = xn[r] + h * acc;
+    }
+    if (S->bp) {
+      int st = fesd__model_g(m, z + S->xo[n], S->u, g);
+      if (st) return st;
+      const double *th = z + fesd__th(S, n, s - 1);
+      double *LB = z + S->lbo[n], *MB = LB + nth;
+      for (int k = 0; k < m->nsys; k++) {
+        double num = 0, den = 0;
+        for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) num += th[i] * g[i], den += th[i];
+        MB[k] = den > 0 ? num / den : g[m->th_off[k]];
+      }
+      for (int i = 0; i < nth; i++) LB[i] = g[i] - MB[m->sys_of[i]];
+    }
+  }
+  return FESD_OK;
+}
+
+/* Copy one stage block (v, theta, lambda, mu) into every stage of element n. */
+void fesd__fill_element(fesd_integrator *it, double *z, int n, const double *block) {
+  fesd__system *S = &it->sys;
+  for (int j = 0; j < S->s; j++) memcpy(z + fesd__v(S, n, j), block, (size_t)S->sb * sizeof(double));
+  if (S->lbo[n] >= 0) {
+    memcpy(z + S->lbo[n], block + S->nx + S->nth, (size_t)S->nth * sizeof(double));
+    memcpy(z + S->lbo[n] + S->nth, block + S->nx + 2 * S->nth, (size_t)S->nsys * sizeof(double));
+  }
+}
+
+/* Stage block from the LP at x: theta = indicator of the argmin of g per subsystem
+ * (ties shared), lambda = g - min g, mu = min g, v = F(x) theta. */
+static int lp_block(fesd_integrator *it, const double *x, const double *u, double *block) {
+  fesd__model *m = &it->model;
+  const int nx = m->nx, nth = m->nth;
+  double *th = block + nx, *la = th + nth, *mu = la + nth;
+  int st = fesd__model_g(m, x, u, it->gbuf);
+  if (st) return st;
+  for (int k = 0; k < m->nsys; k++) {
+    double gmin = INFINITY;
+    for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) gmin = fmin(gmin, it->gbuf[i]);
+    double tie = 1e-12 * fmax(1.0, fabs(gmin));
+    int cnt = 0;
+    for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) cnt += it->gbuf[i] <= gmin + tie;
+    for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) {
+      th[i] = it->gbuf[i] <= gmin + tie ? 1.0 / cnt : 0.0;
+      la[i] = it->gbuf[i] - gmin;
+    }
+    mu[k] = gmin;
+  }
+  memset(block, 0, (size_t)nx * sizeof(double));
+  for (int k = 0; k < m->nsys; k++)
+    for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) {
+      if (th[i] == 0.0) continue;
+      if ((st = m->user.field(k, i - m->th_off[k], x, u, it->gbuf + nth, m->user.user)) != 0) {
+        m->failed = "field";
+        return FESD_ERR_CALLBACK;
+      }
+      for (int r = 0; r < nx; r++) block[r] += th[i] * it->gbuf[nth + r];
+    }
+  return FESD_OK;
+}
+
+int fesd__initial_guess(fesd_integrator *it, const double *u, double T, double *z) {
+  fesd__system *S = &it->sys;
+  if (it->have_ws) {
+    memcpy(it->blk, it->zws + fesd__v(S, S->N - 1, S->s - 1), (size_t)S->sb * sizeof(double));
+  } else {
+    int st = lp_block(it, it->x, u, it->blk);
+    if (st) return st;
+  }
+  for (int n = 0; n < S->N; n++) {
+    fesd__fill_element(it, z, n, it->blk);
+    z[S->ho[n]] = T / S->N;
+  }
+  return fesd__consistent_guess(it, z);
+}
+
