@@ -44,7 +44,48 @@ int fesd__update_lambda00(fesd_integrator *it, const double *x, const double *u,
 
 /* dx_end/d(x_start, u) of the accepted step by the implicit function theorem, chained into
  * Sx, Su. */
+/* Saltation at a crossing or sliding entry that falls exactly on the step start (the
+ * previous step ended on the surface): S <- (I + (f+ - f-) grad psi' / (grad psi' f-)) S,
+ * psi = g_in - g_out, f- = F theta_prev, f+ = F theta of the first stage (paper Prop. 4);
+ * for u also the direct dependence of psi on u. */
+static int start_jump(fesd_integrator *it, const double *z) {
+  fesd__model *m = &it->model;
+  const int nx = m->nx, nu = m->nu, nth = m->nth, a = it->jump_in, b = it->jump_out;
+  fesd__point_eval pe = {0};
+  pe.F = it->sys.pe[0].F;
+  pe.g = it->sys.pe[0].g;
+  pe.dgdx = it->sys.pe[0].dgdx;
+  pe.dgdu = nu > 0 ? it->sys.pe[0].dgdu : NULL;
+  int st = fesd__model_eval(m, it->x, it->sys.u, &pe);
+  if (st) return st;
+  const double *th1 = z + fesd__th(&it->sys, 0, 0);
+  double *df = it->gbuf, den = 0; /* f+ - f- (nx) */
+  for (int r = 0; r < nx; r++) {
+    double fp = 0, fm = 0;
+    for (int i = 0; i < nth; i++) {
+      fp += pe.F[i * nx + r] * th1[i];
+      fm += pe.F[i * nx + r] * it->theta_prev[i];
+    }
+    df[r] = fp - fm;
+    den += (pe.dgdx[r * nth + a] - pe.dgdx[r * nth + b]) * fm;
+  }
+  if (fabs(den) < 1e-300) return FESD_OK; /* grazing: no transversal saltation */
+  /* S <- S + df (grad psi' S) / den, column by column */
+  for (int c = 0; c < nx + nu; c++) {
+    double *col = c < nx ? it->Sx + (size_t)c * nx : it->Su + (size_t)(c - nx) * nx;
+    double gs = 0;
+    for (int r = 0; r < nx; r++) gs += (pe.dgdx[r * nth + a] - pe.dgdx[r * nth + b]) * col[r];
+    if (c >= nx) gs += pe.dgdu[(c - nx) * nth + a] - pe.dgdu[(c - nx) * nth + b];
+    for (int r = 0; r < nx; r++) col[r] += df[r] * gs / den;
+  }
+  return FESD_OK;
+}
+
 static int chain_sensitivities(fesd_integrator *it, const double *z) {
+  if (it->jump_in >= 0) {
+    int sj = start_jump(it, z);
+    if (sj) return sj;
+  }
   fesd__system *S = &it->sys;
   const int nx = it->nx, nu = it->nu, np = nx + nu;
   S->want_u = 1;

@@ -33,6 +33,7 @@ struct fesd_integrator {
   unsigned char *act, *act0, *cand;
   int *bmode, *exit_mode;
   double *zfast;
+  int jump_in, jump_out; /* switch exactly at the step start (mode entering, mode left), or -1 */
   /* records of the last accepted step */
   int cap_el, n_el;
   double *rec_h, *rec_t, *rec_x, *rec_th, *rec_la, *rec_mu;

@@ -228,16 +228,18 @@ static int active_path(fesd_integrator *it, double T, fesd_step_info *info) {
   int k0 = m->th_off[v.sys], k1 = m->th_off[v.sys + 1], ncand = 0;
   unsigned char cands[2][64];
   if (k1 - k0 > 64) return FESD_ERR_STEP_FAILED;
-  int is_exit = !v.enter;
+  int is_exit = !v.enter, i_old_mode = -1;
   if (is_exit) {
     if (!it->set.exit_rows || S->bp) return FESD_ERR_STEP_FAILED; /* paper formulation: FB path */
     for (int i = k0; i < k1; i++) cands[0][i - k0] = it->act0[i] && i != v.mode;
     ncand = 1;
   } else {
     int i_old = k0;
+    i_old_mode = k0;
     for (int i = k0; i < k1; i++)
       if (it->act0[i] && (!it->act0[i_old] || zf[fesd__th(S, 0, 0) + i] > zf[fesd__th(S, 0, 0) + i_old])) i_old = i;
     int cross = 1;
+    i_old_mode = i_old;
     if ((st = crossing_first(it, state_near(it, zf, v.t), i_old, v.mode, &cross))) return st;
     for (int i = k0; i < k1; i++) {
       cands[!cross][i - k0] = i == v.mode;                 /* crossing: j replaces the set */
@@ -271,6 +273,12 @@ static int active_path(fesd_integrator *it, double T, fesd_step_info *info) {
     if (st == FESD_ERR_CALLBACK) return st;
     if (st == FESD_OK) {
       info->switch_step = !at_start;
+      /* a crossing or entry exactly at the step start: the step equations see no switch,
+       * so the sensitivities get the saltation matrix explicitly (fesd__start_jump) */
+      if (at_start && !is_exit) {
+        it->jump_in = v.mode;
+        it->jump_out = i_old_mode;
+      }
       return FESD_OK;
     }
   }
@@ -289,11 +297,13 @@ static int try_step(fesd_integrator *it, const double *u, double T, fesd_step_in
   if (st) return st;
   set_h_bounds(it, T);
   if ((st = fesd__act_start(it, u, it->act0))) return st;
+  it->jump_in = -1;
   st = active_path(it, T, info);
   if (st == FESD_ERR_CALLBACK) return st;
   if (st != FESD_OK) {
     st = fb_path(it, T, info);
     if (st) return st;
+    it->jump_in = -1;
   }
   double ccm = 0;
   if (it->set.method == FESD_METHOD_FESD && !fesd__valid(it, it->z, &ccm)) return FESD_ERR_STEP_FAILED;

@@ -104,6 +104,23 @@ static int exact_c(double t, double *x) {
   return 0;
 }
 
+/* ---- stewart-anitescu: x' in 2 - sign(x) with the running cost q' = x^2 ---- */
+static int sa_field(int sys, int mode, const double *x, const double *u, double *f, void *user) {
+  (void)sys, (void)u, (void)user;
+  f[0] = mode == 0 ? 1.0 : 3.0;
+  f[1] = x[0] * x[0];
+  return 0;
+}
+static int sa_field_jac(int sys, int mode, const double *x, const double *u, double *J, double *Ju,
+                        void *user) {
+  (void)sys, (void)mode, (void)u, (void)Ju, (void)user;
+  J[0] = 0;
+  J[1] = 2 * x[0];
+  J[2] = 0;
+  J[3] = 0;
+  return 0;
+}
+
 /* ---- ocp-dynamics (paper Sec. 5): q' = -sign(c(q)) + v, v' = u, two subsystems ---- */
 static const int two_sys_modes[2] = {2, 2};
 static const int two_sys_switch[2] = {1, 1};
@@ -157,8 +174,9 @@ static int ocp_sw_jac(int sys, const double *x, const double *u, double *J, doub
   return 0;
 }
 
-static const char *const names[] = {"oscillator", "sign-a", "sign-b", "sign-c", "sign-d",
-                                    "nonlipschitz", "ocp-dynamics", NULL};
+static const char *const names[] = {"oscillator", "sign-a",       "sign-b",       "sign-c",
+                                    "sign-d",     "nonlipschitz", "ocp-dynamics", "stewart-anitescu",
+                                    NULL};
 
 const char *const *fesd_problem_names(void) { return names; }
 
@@ -217,8 +235,64 @@ int fesd_problem_get(const char *name, fesd_problem *p) {
     p->x0[0] = 2 * PI / 3;
     p->x0[1] = PI / 3;
     p->T = 4.0;
+  } else if (!strcmp(name, "stewart-anitescu")) {
+    p->name = "stewart-anitescu";
+    p->description = "x' in 2 - sign(x), q' = x^2 (running cost), x0 = (-1, 0), T = 2";
+    p->model = (fesd_model){2, 0, 1, one_sys_two_modes, one_switch, NULL, sa_field, sa_field_jac,
+                            scalar_sw, scalar_sw_jac, NULL};
+    p->x0[0] = -1.0;
+    p->T = 2.0;
+    p->t_switch = 1.0 / 3;
   } else {
     return FESD_ERR_INVALID_ARG;
   }
   return FESD_OK;
+}
+
+/* ---- Stewart-Anitescu value function (paper Sec. 4.5, Fig. ivp_problem) ---- */
+
+double fesd_sa_exact_value(double x0, double *dV) {
+  double V, d;
+  if (x0 >= 0) {
+    V = ((x0 + 2) * (x0 + 2) * (x0 + 2) - x0 * x0 * x0) / 3 + (x0 + 1.0 / 3) * (x0 + 1.0 / 3);
+    d = (x0 + 2) * (x0 + 2) - x0 * x0 + 2 * (x0 + 1.0 / 3);
+  } else {
+    double a = 2 + x0 / 3, b = (1 + x0) / 3;
+    V = -x0 * x0 * x0 / 9 + a * a * a / 3 + b * b;
+    d = -x0 * x0 / 3 + a * a / 3 + 2 * b / 3;
+  }
+  if (dV) *dV = d;
+  return V;
+}
+
+int fesd_sa_value(fesd_integrator *it, double x0, int nsim, double *V, double *dV) {
+  double x[2] = {x0, 0}, S[4];
+  int st = fesd_set_state(it, 0, x, NULL);
+  for (int k = 0; k < nsim && !st; k++) st = fesd_step(it, NULL, 2.0 / nsim, NULL);
+  if (st) return st;
+  fesd_get_state(it, NULL, x);
+  if ((st = fesd_get_sensitivities(it, S, NULL))) return st;
+  *V = x[1] + (x[0] - 5.0 / 3) * (x[0] - 5.0 / 3);
+  *dV = S[1] + 2 * (x[0] - 5.0 / 3) * S[0]; /* column 0: d(x, q)(T)/dx0 */
+  return FESD_OK;
+}
+
+int fesd_sa_shoot(fesd_integrator *it, double x_start, int nsim, double *x_opt, int *iters) {
+  double xa = x_start, xb = x_start + 1e-2, Va, Vb, ga, gb;
+  int st = fesd_sa_value(it, xa, nsim, &Va, &ga);
+  if (!st) st = fesd_sa_value(it, xb, nsim, &Vb, &gb);
+  int k = 0;
+  for (; k < 100 && !st; k++) {
+    if (fabs(gb) <= 1e-12 || gb == ga) break;
+    double step = -gb * (xb - xa) / (gb - ga); /* secant on dV/dx0 */
+    if (step > 1) step = 1;
+    if (step < -1) step = -1;
+    xa = xb, ga = gb;
+    xb = xb + step;
+    st = fesd_sa_value(it, xb, nsim, &Vb, &gb);
+    if (fabs(step) <= 1e-13 * fmax(1, fabs(xb))) break;
+  }
+  *x_opt = xb;
+  *iters = k;
+  return st;
 }

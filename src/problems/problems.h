@@ -29,4 +29,12 @@ const char *const *fesd_problem_names(void);
 /* Oscillator exact solution from x(0) = (e^-1, 0). */
 int fesd_problem_oscillator_exact(double t, double *x);
 
+/* Stewart-Anitescu problem (DESIGN.md section 5): exact V(x0) = int_0^2 x^2 dt +
+ * (x(2) - 5/3)^2 and dV/dx0; the value and gradient from an integrator created with
+ * settings.sensitivities = 1 on the "stewart-anitescu" model (nsim steps over [0, 2]);
+ * and a secant shooting on dV/dx0 from x_start. */
+double fesd_sa_exact_value(double x0, double *dV);
+int fesd_sa_value(fesd_integrator *it, double x0, int nsim, double *V, double *dV);
+int fesd_sa_shoot(fesd_integrator *it, double x_start, int nsim, double *x_opt, int *iters);
+
 #endif
