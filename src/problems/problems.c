@@ -121,6 +121,64 @@ static int sa_field_jac(int sys, int mode, const double *x, const double *u, dou
   return 0;
 }
 
+/* ---- slide-exit-2d (notes/sliding_exit.md): sliding on the curved surface
+ * c = x1 + x2^2/2 from x0 = 0, leaving it when the sliding multiplier of the c < 0 mode
+ * reaches 0. mode 0 (c > 0): f = (-1 + x2, (1 + x2^2)/2); mode 1: f = (1 + x2, (1 + x2^2)/2 + x2/2) */
+static int se_field(int sys, int mode, const double *x, const double *u, double *f, void *user) {
+  (void)sys, (void)u, (void)user;
+  f[0] = (mode == 0 ? -1.0 : 1.0) + x[1];
+  f[1] = 0.5 * (1 + x[1] * x[1]) + (mode == 0 ? 0.0 : 0.5 * x[1]);
+  return 0;
+}
+static int se_field_jac(int sys, int mode, const double *x, const double *u, double *J, double *Ju,
+                        void *user) {
+  (void)sys, (void)u, (void)Ju, (void)user;
+  J[0] = 0;
+  J[1] = 0;
+  J[2] = 1;
+  J[3] = x[1] + (mode == 0 ? 0.0 : 0.5);
+  return 0;
+}
+static int se_sw(int sys, const double *x, const double *u, double *c, void *user) {
+  (void)sys, (void)u, (void)user;
+  c[0] = x[0] + 0.5 * x[1] * x[1];
+  return 0;
+}
+static int se_sw_jac(int sys, const double *x, const double *u, double *J, double *Ju, void *user) {
+  (void)sys, (void)u, (void)Ju, (void)user;
+  J[0] = 1;
+  J[1] = x[1];
+  return 0;
+}
+/* sliding multiplier of mode 1 and the sliding speed of x2 */
+static double se_theta1(double y) { return (1 - 1.5 * y - 0.5 * y * y * y) / (2 + 0.5 * y * y); }
+static double se_speed(double y) { return 0.5 * (1 + y * y) + 0.5 * y * se_theta1(y); }
+
+void fesd_problem_slide_exit_point(double *t_exit, double *x2_exit) {
+  double a = 0, b = 1; /* theta1(0) = 0.5 > 0 > theta1(1): bisection on the cubic */
+  for (int i = 0; i < 200; i++) {
+    double m = 0.5 * (a + b);
+    if (se_theta1(m) > 0) a = m; else b = m;
+  }
+  double y = 0.5 * (a + b), h = y / 4000, acc = 0; /* composite Simpson for int dy / speed */
+  for (int i = 0; i < 4000; i++) {
+    double y0 = i * h;
+    acc += h / 6 * (1 / se_speed(y0) + 4 / se_speed(y0 + h / 2) + 1 / se_speed(y0 + h));
+  }
+  *t_exit = acc;
+  *x2_exit = y;
+}
+
+static int se_exact(double t, double *x) {
+  double ts, ys;
+  fesd_problem_slide_exit_point(&ts, &ys);
+  if (t < ts) return -1; /* the sliding phase has no closed form */
+  double ph = atan(ys), arg = 0.5 * (t - ts) + ph;
+  x[1] = tan(arg);
+  x[0] = -0.5 * ys * ys - (t - ts) - 2 * log(cos(arg)) + 2 * log(cos(ph));
+  return 0;
+}
+
 /* ---- ocp-dynamics (paper Sec. 5): q' = -sign(c(q)) + v, v' = u, two subsystems ---- */
 static const int two_sys_modes[2] = {2, 2};
 static const int two_sys_switch[2] = {1, 1};
@@ -176,7 +234,7 @@ static int ocp_sw_jac(int sys, const double *x, const double *u, double *J, doub
 
 static const char *const names[] = {"oscillator", "sign-a",       "sign-b",       "sign-c",
                                     "sign-d",     "nonlipschitz", "ocp-dynamics", "stewart-anitescu",
-                                    NULL};
+                                    "slide-exit-2d", NULL};
 
 const char *const *fesd_problem_names(void) { return names; }
 
@@ -243,6 +301,15 @@ int fesd_problem_get(const char *name, fesd_problem *p) {
     p->x0[0] = -1.0;
     p->T = 2.0;
     p->t_switch = 1.0 / 3;
+  } else if (!strcmp(name, "slide-exit-2d")) {
+    p->name = "slide-exit-2d";
+    p->description = "slides on c = x1 + x2^2/2 from x0 = 0, leaves it at t = 1.02617735";
+    p->model = (fesd_model){2, 0, 1, one_sys_two_modes, one_switch, NULL, se_field, se_field_jac,
+                            se_sw, se_sw_jac, NULL};
+    p->T = 2.1;
+    double x2;
+    fesd_problem_slide_exit_point(&p->t_switch, &x2);
+    p->exact = se_exact;
   } else {
     return FESD_ERR_INVALID_ARG;
   }

@@ -29,6 +29,10 @@ const char *const *fesd_problem_names(void);
 /* Oscillator exact solution from x(0) = (e^-1, 0). */
 int fesd_problem_oscillator_exact(double t, double *x);
 
+/* slide-exit-2d: exit time and exit value of x2, computed independently of the integrator
+ * (bisection on the sliding multiplier, composite Simpson for the time). */
+void fesd_problem_slide_exit_point(double *t_exit, double *x2_exit);
+
 /* Stewart-Anitescu problem (DESIGN.md section 5): exact V(x0) = int_0^2 x^2 dt +
  * (x(2) - 5/3)^2 and dV/dx0; the value and gradient from an integrator created with
  * settings.sensitivities = 1 on the "stewart-anitescu" model (nsim steps over [0, 2]);
