@@ -232,6 +232,26 @@ static int ocp_sw_jac(int sys, const double *x, const double *u, double *J, doub
   return 0;
 }
 
+/* ocp-dynamics with u = 0: q1 = 2pi/3 - t until 2pi/3; q2 = pi/3 - t until c2 = 0 at t1,
+ * then q2 = 0.05 q1^3 (sliding on c2 = 0); the origin from 2pi/3 on; v = 0. */
+double fesd_problem_ocp_t1(void) {
+  const double t2 = 2 * PI / 3;
+  double a = 0, b = 1.5;
+  for (int i = 0; i < 200; i++) {
+    double m = 0.5 * (a + b), q1 = t2 - m;
+    if (-0.05 * q1 * q1 * q1 + (t2 / 2 - m) > 0) a = m; else b = m;
+  }
+  return 0.5 * (a + b);
+}
+static int ocp_exact(double t, double *x) {
+  const double t2 = 2 * PI / 3, t1 = fesd_problem_ocp_t1();
+  double q1 = t < t2 ? t2 - t : 0;
+  x[0] = q1;
+  x[1] = t < t1 ? PI / 3 - t : 0.05 * q1 * q1 * q1;
+  x[2] = x[3] = 0;
+  return 0;
+}
+
 static const char *const names[] = {"oscillator", "sign-a",       "sign-b",       "sign-c",
                                     "sign-d",     "nonlipschitz", "ocp-dynamics", "stewart-anitescu",
                                     "slide-exit-2d", NULL};
@@ -293,6 +313,8 @@ int fesd_problem_get(const char *name, fesd_problem *p) {
     p->x0[0] = 2 * PI / 3;
     p->x0[1] = PI / 3;
     p->T = 4.0;
+    p->t_switch = fesd_problem_ocp_t1();
+    p->exact = ocp_exact;
   } else if (!strcmp(name, "stewart-anitescu")) {
     p->name = "stewart-anitescu";
     p->description = "x' in 2 - sign(x), q' = x^2 (running cost), x0 = (-1, 0), T = 2";

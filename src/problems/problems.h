@@ -29,6 +29,9 @@ const char *const *fesd_problem_names(void);
 /* Oscillator exact solution from x(0) = (e^-1, 0). */
 int fesd_problem_oscillator_exact(double t, double *x);
 
+/* ocp-dynamics: time at which the trajectory reaches c2 = 0 (bisection). */
+double fesd_problem_ocp_t1(void);
+
 /* slide-exit-2d: exit time and exit value of x2, computed independently of the integrator
  * (bisection on the sliding multiplier, composite Simpson for the time). */
 void fesd_problem_slide_exit_point(double *t_exit, double *x2_exit);
