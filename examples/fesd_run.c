@@ -189,9 +189,9 @@ int main(int argc, char **argv) {
     }
     printf("\n");
   }
-  printf("steps %d (switch steps %d, splits %d), Newton iterations %d (ordinary steps: mean %.2f max %.0f;"
+  printf("steps %d (switch steps %d, splits %d, FB fallbacks %d), Newton iterations %d (ordinary steps: mean %.2f max %.0f;"
          " switch steps: mean %.2f max %.0f), factorizations %d, events %d, time %.3f ms\n",
-         S.steps, S.switch_steps, S.splits, S.newton_iter, S.mean_iter_ordinary_step,
+         S.steps, S.switch_steps, S.splits, S.fallback_steps, S.newton_iter, S.mean_iter_ordinary_step,
          S.max_iter_ordinary_step, S.mean_iter_switch_step, S.max_iter_switch_step, S.factorizations,
          S.events, 1e3 * S.time);
   fesd_free(&it);

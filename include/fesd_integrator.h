@@ -109,6 +109,7 @@ typedef struct {
   int homotopy_stages;
   int splits;           /**< sub-steps added by recovery (0 = none) */
   int switch_step;      /**< 1 if the accepted solution needed a switch solve */
+  int fallback;         /**< sub-steps solved by the FB fallback path (active-set path failed) */
   double residual;      /**< final ||F||_inf of the accepted system */
   double cc_max;        /**< max cross-complementarity product of the accepted solution */
   double time;          /**< wall-clock seconds of the step */
@@ -173,6 +174,7 @@ FESD_API int fesd_last_step_data(const fesd_integrator *it, fesd_step_data *data
 /** Accumulated statistics since fesd_set_state. */
 typedef struct {
   int steps, switch_steps, newton_iter, factorizations, solves, homotopy_stages, splits;
+  int fallback_steps;      /**< steps (or sub-steps) solved by the FB fallback path */
   int events;
   double time;             /**< wall-clock seconds in fesd_step */
   double max_iter_ordinary_step; /**< max Newton iterations of a step without switch */

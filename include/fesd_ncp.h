@@ -20,9 +20,11 @@
  * order: active eq rows by increasing index, then for k = 0..n_pair-1 the FB row of
  * k (FB mode), the rows a_k, b_k (PIN), the row a_k (A) or the row b_k (B); OFF
  * pairs contribute nothing.
- *   m == n : square semismooth Newton with Armijo line search on 1/2||F||^2
- *            (gradient step fallback when the Newton direction is not a descent
- *            direction).
+ *   m == n : square semismooth Newton with Armijo line search on 1/2||F||^2; when
+ *            the Newton direction fails the descent test or needs more than 9 step
+ *            cuts, an LM-regularized step (dense) or a Cauchy-scaled gradient step
+ *            (sparse) is taken instead. No progress for 5 iterations (a nonzero local
+ *            minimizer of 1/2||F||^2) gives FESD_ERR_LINE_SEARCH.
  *   m  > n : Levenberg-Marquardt (the system must be consistent; a stationary
  *            point with nonzero residual returns FESD_ERR_INCONSISTENT).
  *   m  < n : FESD_ERR_DIMENSION.
@@ -31,8 +33,10 @@
  *
  * Memory. All allocation happens in fesd_ncp_setup() (and in fesd_ncp_set_rows()
  * for the sparse backends when the row selection changes the pattern). Dense and
- * KLU backends allocate nothing while solving; UMFPACK's numeric factorization
- * allocates by design. Reentrant: one workspace per thread.
+ * KLU backends allocate nothing while solving (KLU only on its first factorization
+ * of a pattern and when a pivot-order refactor is rejected); UMFPACK's numeric
+ * factorization and CHOLMOD's factorization of J'J + mu I allocate by design.
+ * Reentrant: one workspace per thread.
  */
 #ifndef FESD_NCP_H
 #define FESD_NCP_H
@@ -45,7 +49,7 @@ extern "C" {
 
 typedef enum {
   FESD_NCP_BACKEND_AUTO = 0, /**< dense if n <= settings.dense_max_n, else KLU (square) / CHOLMOD (m > n) */
-  FESD_NCP_BACKEND_DENSE = 1, /**< LAPACK LU (square), LAPACK QR / Cholesky (LM) */
+  FESD_NCP_BACKEND_DENSE = 1, /**< LU (unblocked up to n = 48, LAPACK above) (square), LAPACK Cholesky of J'J + mu I (LM) */
   FESD_NCP_BACKEND_UMFPACK = 2, /**< square sparse LU, symbolic analysis reused */
   FESD_NCP_BACKEND_KLU = 3,     /**< square sparse LU, klu_refactor reuse (no allocation per iteration) */
   FESD_NCP_BACKEND_CHOLMOD = 4  /**< LM normal equations J'J + mu I, analysis reused */
@@ -96,18 +100,20 @@ typedef struct {
   int dense_max_n;       /**< AUTO uses the dense backend up to this n (default FESD_NCP_DENSE_MAX_N) */
   double armijo;         /**< Armijo constant c1 in (0, 0.5) (default 1e-4) */
   double backtrack;      /**< step reduction factor in (0,1) (default 0.5) */
-  int max_backtracks;    /**< line-search trials per iteration (default 30) */
+  int max_backtracks;    /**< line-search trials per direction (default 30; a Newton direction gets at most 10 before the fallback) */
   double sigma0;         /**< first smoothing parameter of the homotopy (default 1e-1) */
   double sigma_factor;   /**< sigma_{k+1} = factor * sigma_k (default 0.1) */
   double sigma_min;      /**< last positive sigma before the final sigma = 0 stage (default 1e-8) */
   double homotopy_tol_factor; /**< intermediate stages stop at ||F|| <= factor*sigma (default 1e-2) */
-  double lm_mu0;         /**< initial LM damping relative to ||J'F|| (default 1e-3) */
+  double lm_mu0;         /**< initial LM damping factor: mu = lambda ||F||_2, lambda adapted by the gain ratio (default 1e-3) */
   fesd_ncp_log_fn log;   /**< optional iteration log (default NULL = silent) */
   void *log_user;
 } fesd_ncp_settings;
 
-/** Default dense/sparse crossover of the AUTO backend (measured by bench/ncp_bench). */
-#define FESD_NCP_DENSE_MAX_N 300
+/** Default dense/sparse crossover of the AUTO backend (measured by bench/ncp_bench and on
+ *  the FESD reference problems, docs/ncp.md: KLU is faster above ~50 unknowns at FESD's
+ *  10-20 % Jacobian density). */
+#define FESD_NCP_DENSE_MAX_N 50
 /** Entries kept in fesd_ncp_info.residual_history. */
 #define FESD_NCP_HISTORY 64
 
@@ -127,7 +133,7 @@ typedef struct {
   double time_eval;      /**< seconds in the user callback */
   double time_linsolve;  /**< seconds in factorizations and solves */
   int history_len;       /**< entries used in residual_history */
-  double residual_history[FESD_NCP_HISTORY]; /**< ||F||_inf at the start of each iteration, then final */
+  double residual_history[FESD_NCP_HISTORY]; /**< ||F||_inf at the start of each iteration, then final (per stage; the most recent entries when more) */
 } fesd_ncp_info;
 
 typedef struct fesd_ncp fesd_ncp; /**< opaque workspace */
@@ -141,8 +147,9 @@ FESD_API int fesd_ncp_settings_default(fesd_ncp_settings *s);
  * @param[out] ws  new workspace (NULL on error; nothing leaks)
  * @param[in]  p   problem (not modified)
  * @param[in]  s   settings, or NULL for defaults
- * @return FESD_OK, FESD_ERR_NULL, FESD_ERR_DIMENSION, FESD_ERR_PATTERN, FESD_ERR_INVALID_ARG,
- *         FESD_ERR_NOMEM, FESD_ERR_LINSOLVE.
+ * @return FESD_OK, FESD_ERR_NULL, FESD_ERR_DIMENSION (n < 1, a negative count, or
+ *         n_eq + n_pair < n: the default selection must not be under-determined),
+ *         FESD_ERR_PATTERN, FESD_ERR_INVALID_ARG, FESD_ERR_NOMEM, FESD_ERR_LINSOLVE.
  */
 FESD_API int fesd_ncp_setup(fesd_ncp **ws, const fesd_ncp_problem *p, const fesd_ncp_settings *s);
 
@@ -159,14 +166,18 @@ FESD_API int fesd_ncp_set_rows(fesd_ncp *ws, const unsigned char *eq_active,
                                const unsigned char *pair_mode);
 
 /**
- * @brief Optional box on the unknowns: every trial point is projected onto [lb, ub]
- *        (a safeguard, e.g. element lengths > 0). NULL arrays remove the box.
+ * @brief Optional box on the unknowns: the initial guess and every trial point are
+ *        projected onto [lb, ub] (a safeguard, e.g. element lengths > 0). A NULL lb / ub
+ *        means -inf / +inf; both NULL remove the box. FESD_ERR_INVALID_ARG if lb > ub or NaN.
  */
 FESD_API int fesd_ncp_set_bounds(fesd_ncp *ws, const double *lb, const double *ub);
 
 /**
  * @brief Solve F_sigma(z) = 0 from the initial guess z (overwritten by the last iterate).
- * @return FESD_OK if ||F||_inf <= tol, else the failure status (also in info->status).
+ * @return FESD_OK if ||F||_inf <= tol, else the failure status (also in info->status):
+ *         FESD_ERR_INVALID_ARG (sigma < 0 or not finite), FESD_ERR_NOT_READY (the last
+ *         fesd_ncp_set_rows failed), FESD_ERR_MAX_ITER, FESD_ERR_LINE_SEARCH,
+ *         FESD_ERR_SINGULAR, FESD_ERR_INCONSISTENT (m > n), FESD_ERR_CALLBACK, ...
  * info may be NULL.
  */
 FESD_API int fesd_ncp_solve(fesd_ncp *ws, double *z, double sigma, fesd_ncp_info *info);

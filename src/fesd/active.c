@@ -43,8 +43,10 @@ int fesd__act_start(fesd_integrator *it, const double *u, unsigned char *a) {
   return FESD_OK;
 }
 
-/* theta restricted to the active set of each element (renormalised per subsystem,
- * uniform where the guess had no weight on the active modes). */
+/* theta restricted to the active set of each element, renormalised per subsystem; a
+ * subsystem where some active mode has (almost) no weight in the guess (a newly active
+ * mode, e.g. a sliding candidate) starts from uniform weights, which keeps the
+ * cross-complementarity row of that mode non-degenerate. */
 void fesd__impose_active(fesd_integrator *it, double *z, const unsigned char *act) {
   fesd__system *S = &it->sys;
   const fesd__model *m = &it->model;
@@ -53,18 +55,21 @@ void fesd__impose_active(fesd_integrator *it, double *z, const unsigned char *ac
     for (int j = 0; j < S->s; j++) {
       double *th = z + fesd__th(S, n, j);
       for (int k = 0; k < m->nsys; k++) {
-        double sum = 0;
+        double sum = 0, low = INFINITY;
         int cnt = 0;
         for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) {
-          if (!a[i]) th[i] = 0;
-          else {
-            th[i] = fmax(th[i], 0.0);
-            sum += th[i];
-            cnt++;
+          if (!a[i]) {
+            th[i] = 0;
+            continue;
           }
+          th[i] = fmax(th[i], 0.0);
+          sum += th[i];
+          low = fmin(low, th[i]);
+          cnt++;
         }
+        int uniform = cnt > 0 && (low < 1e-3 * sum || sum <= 0);
         for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++)
-          if (a[i]) th[i] = sum > 1e-3 ? th[i] / sum : 1.0 / cnt;
+          if (a[i]) th[i] = uniform ? 1.0 / cnt : th[i] / sum;
       }
     }
   }

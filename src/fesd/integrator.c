@@ -258,6 +258,7 @@ int fesd_step(fesd_integrator *it, const double *u, double T, fesd_step_info *in
   S->solves += info->solves;
   S->homotopy_stages += info->homotopy_stages;
   S->splits += info->splits;
+  S->fallback_steps += info->fallback;
   S->events += it->n_events;
   S->time += info->time;
   int sw = info->switch_step || info->splits > 0;

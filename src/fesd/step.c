@@ -303,6 +303,7 @@ static int try_step(fesd_integrator *it, const double *u, double T, fesd_step_in
   if (st != FESD_OK) {
     st = fb_path(it, T, info);
     if (st) return st;
+    info->fallback++;
     it->jump_in = -1;
   }
   double ccm = 0;
