@@ -21,5 +21,12 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 
 if [ ! -f "$BUILD_DIR/build.ninja" ]; then
-  meson setup "$BUILD_DIR" "$@" >/dev/null
+  log=$(mktemp)
+  if ! meson setup "$BUILD_DIR" "$@" >"$log" 2>&1; then
+    cat "$log" >&2
+    rm -f "$log"
+    echo "setup: meson setup failed" >&2
+    exit 1
+  fi
+  rm -f "$log"
 fi
