@@ -1,0 +1,169 @@
+/* Dense backends: LU of the square Jacobian (in place, no copy) and Cholesky of
+ * the normal matrix J'J + mu I for Levenberg-Marquardt. */
+#include "ncp/linsolve.h"
+
+#include "common/lapack.h"
+#include "fesd_ncp.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+/* Up to this order an unblocked LU beats LAPACK's dgetrf/dgetrs, whose call and
+ * blocking overhead dominates small systems (bench/ncp_bench, docs/ncp.md). */
+#define SMALL_LU_MAX_N 48
+
+/* Right-looking LU with partial pivoting, column-major; 0-based pivots.
+ * Returns k+1 when column k has no nonzero pivot (as dgetrf's info). */
+static int small_lu(int n, double *a, int *piv) {
+  for (int k = 0; k < n; k++) {
+    double *ck = a + (size_t)k * n, big = fabs(ck[k]);
+    int p = k;
+    for (int i = k + 1; i < n; i++)
+      if (fabs(ck[i]) > big) {
+        big = fabs(ck[i]);
+        p = i;
+      }
+    piv[k] = p;
+    if (big == 0.0) return k + 1;
+    if (p != k)
+      for (int j = 0; j < n; j++) {
+        double t = a[k + (size_t)j * n];
+        a[k + (size_t)j * n] = a[p + (size_t)j * n];
+        a[p + (size_t)j * n] = t;
+      }
+    const double inv = 1.0 / ck[k];
+    for (int i = k + 1; i < n; i++) ck[i] *= inv;
+    for (int j = k + 1; j < n; j++) {
+      double *cj = a + (size_t)j * n, f = cj[k];
+      if (f != 0.0)
+        for (int i = k + 1; i < n; i++) cj[i] -= f * ck[i];
+    }
+  }
+  return 0;
+}
+
+static void small_lu_solve(int n, const double *a, const int *piv, double *x) {
+  for (int k = 0; k < n; k++)
+    if (piv[k] != k) {
+      double t = x[k];
+      x[k] = x[piv[k]];
+      x[piv[k]] = t;
+    }
+  for (int k = 0; k < n; k++) { /* L y = P b, unit diagonal */
+    const double *ck = a + (size_t)k * n, xk = x[k];
+    for (int i = k + 1; i < n; i++) x[i] -= ck[i] * xk;
+  }
+  for (int k = n - 1; k >= 0; k--) { /* U x = y */
+    const double *ck = a + (size_t)k * n;
+    x[k] /= ck[k];
+    const double xk = x[k];
+    for (int i = 0; i < k; i++) x[i] -= ck[i] * xk;
+  }
+}
+
+typedef struct {
+  fesd__ls base;
+  int *ipiv;
+  double *lu; /* the caller's values array, factorized in place */
+} dense_lu;
+
+typedef struct {
+  fesd__ls base;
+  double *nrm; /* n x n normal matrix, lower triangle used */
+} dense_normal;
+
+static int dense_analyze(fesd__ls *ls, int m, const int *p, const int *idx) {
+  (void)p;
+  (void)idx;
+  ls->m = m;
+  return FESD_OK;
+}
+
+static int lu_factor(fesd__ls *ls, double *values, double mu) {
+  dense_lu *d = (dense_lu *)ls;
+  int n = ls->n, info = 0;
+  (void)mu;
+  d->lu = values;
+  if (n <= SMALL_LU_MAX_N) return small_lu(n, values, d->ipiv) ? FESD_ERR_SINGULAR : FESD_OK;
+  dgetrf_(&n, &n, values, &n, d->ipiv, &info);
+  if (info < 0) return FESD_ERR_LINSOLVE;
+  return info > 0 ? FESD_ERR_SINGULAR : FESD_OK;
+}
+
+static int lu_solve(fesd__ls *ls, double *x) {
+  dense_lu *d = (dense_lu *)ls;
+  int n = ls->n, one = 1, info = 0;
+  if (n <= SMALL_LU_MAX_N) {
+    small_lu_solve(n, d->lu, d->ipiv, x);
+    return FESD_OK;
+  }
+  dgetrs_("N", &n, &one, d->lu, &n, d->ipiv, x, &n, &info, 1);
+  return info == 0 ? FESD_OK : FESD_ERR_LINSOLVE;
+}
+
+static void lu_destroy(fesd__ls *ls) {
+  dense_lu *d = (dense_lu *)ls;
+  free(d->ipiv);
+  free(d);
+}
+
+static const fesd__ls_ops dense_lu_ops = {FESD__LS_LU, FESD__LAYOUT_DENSE, 1, dense_analyze,
+                                          lu_factor,   lu_solve,           lu_destroy};
+
+int fesd__ls_dense_lu_create(fesd__ls **ls, int n) {
+  dense_lu *d = calloc(1, sizeof *d);
+  if (!d) return FESD_ERR_NOMEM;
+  d->ipiv = malloc((size_t)n * sizeof *d->ipiv);
+  if (!d->ipiv) {
+    free(d);
+    return FESD_ERR_NOMEM;
+  }
+  d->base.ops = &dense_lu_ops;
+  d->base.backend = FESD_NCP_BACKEND_DENSE;
+  d->base.n = d->base.m = n;
+  *ls = &d->base;
+  return FESD_OK;
+}
+
+static int normal_factor(fesd__ls *ls, double *values, double mu) {
+  dense_normal *d = (dense_normal *)ls;
+  int n = ls->n, m = ls->m, info = 0;
+  const double one = 1.0, zero = 0.0;
+  dsyrk_("L", "T", &n, &m, &one, values, &m, &zero, d->nrm, &n, 1, 1);
+  for (int j = 0; j < n; j++) d->nrm[j + (size_t)j * n] += mu;
+  dpotrf_("L", &n, d->nrm, &n, &info, 1);
+  if (info < 0) return FESD_ERR_LINSOLVE;
+  return info > 0 ? FESD_ERR_SINGULAR : FESD_OK;
+}
+
+static int normal_solve(fesd__ls *ls, double *x) {
+  dense_normal *d = (dense_normal *)ls;
+  int n = ls->n, one = 1, info = 0;
+  dpotrs_("L", &n, &one, d->nrm, &n, x, &n, &info, 1);
+  return info == 0 ? FESD_OK : FESD_ERR_LINSOLVE;
+}
+
+static void normal_destroy(fesd__ls *ls) {
+  dense_normal *d = (dense_normal *)ls;
+  free(d->nrm);
+  free(d);
+}
+
+static const fesd__ls_ops dense_normal_ops = {FESD__LS_NORMAL, FESD__LAYOUT_DENSE, 0,
+                                              dense_analyze,   normal_factor,      normal_solve,
+                                              normal_destroy};
+
+int fesd__ls_dense_normal_create(fesd__ls **ls, int n) {
+  dense_normal *d = calloc(1, sizeof *d);
+  if (!d) return FESD_ERR_NOMEM;
+  d->nrm = malloc((size_t)n * (size_t)n * sizeof *d->nrm);
+  if (!d->nrm) {
+    free(d);
+    return FESD_ERR_NOMEM;
+  }
+  d->base.ops = &dense_normal_ops;
+  d->base.backend = FESD_NCP_BACKEND_DENSE;
+  d->base.n = d->base.m = n;
+  *ls = &d->base;
+  return FESD_OK;
+}

@@ -1,0 +1,71 @@
+/* Workspace of the semismooth Newton solver (internal to src/ncp). */
+#ifndef FESD_NCP_INTERNAL_H
+#define FESD_NCP_INTERNAL_H
+
+#include "fesd_ncp.h"
+#include "ncp/linsolve.h"
+
+/* Accumulated statistics of one public call (copied into fesd_ncp_info). */
+typedef struct {
+  int iterations, stages, factorizations, evals, jac_evals, backtracks;
+  double time_eval, time_linsolve;
+} fesd__ncp_stats;
+
+struct fesd_ncp {
+  /* problem (copied at setup) */
+  int n, n_eq, n_pair, nnz, n_raw, m_max;
+  int *trow, *tcol;
+  fesd_ncp_eval_fn eval;
+  void *user;
+  fesd_ncp_settings set;
+  int dense; /* dense backends chosen at setup */
+
+  /* linear solvers: square LU (NULL for CHOLMOD) and normal equations (lazy when sparse) */
+  fesd__ls *lu, *normal;
+  fesd__ls *active; /* the one used by the current row selection */
+  int ready;        /* 0 after a failed re-analysis: solves return FESD_ERR_NOT_READY */
+
+  /* row selection */
+  unsigned char *eq_on, *pair_mode;
+  int m, n_eq_on, n_fb;
+  int *eq_list;  /* active eq rows, increasing */
+  int *pair_pos; /* assembled row of each pair (-1 when OFF) */
+  int *fb_list;  /* pairs in FB mode */
+
+  /* assembly maps over the active pattern entries */
+  int n_act;
+  int *act_src;  /* index into the user's jac array */
+  int *act_wrow; /* raw row whose weight multiplies the entry */
+  int *act_tgt;  /* position in vals */
+  int *act_r, *act_c; /* assembled row / column (pattern building scratch) */
+  int *sp_p, *sp_i;   /* sparse pattern of the active layout */
+  int *work;          /* pattern building scratch */
+  int nvals;          /* entries of vals in the current layout */
+  double *vals;       /* assembled Jacobian values */
+  double *wgt;        /* n_raw chain-rule weights: 1 for eq/PIN rows, da/db for FB */
+
+  /* iteration buffers (n_raw, nnz, m_max, n) */
+  double *raw_c, *raw_t, *jac_c, *jac_t, *F_c, *F_t;
+  double *zt, *d, *g, *tmp, *z0;
+  double *lb, *ub;
+  int has_box;
+
+  fesd__ncp_stats pending; /* sensitivity work, reported by the next solve */
+};
+
+/* assemble.c */
+void fesd__ncp_residual(const fesd_ncp *ws, const double *raw, double sigma, double *F);
+void fesd__ncp_weights(fesd_ncp *ws, const double *raw, double sigma);
+void fesd__ncp_jacobian(fesd_ncp *ws, const double *jac);
+void fesd__ncp_jt_mul(const fesd_ncp *ws, const double *x, double *y); /* y = J' x */
+void fesd__ncp_j_mul(const fesd_ncp *ws, const double *x, double *y);  /* y = J x */
+double fesd__ncp_frobenius(const fesd_ncp *ws);
+int fesd__all_finite(const double *x, int n);
+
+/* rows.c */
+int fesd__ncp_apply_rows(fesd_ncp *ws);
+
+/* newton.c: callback wrapper shared with sensitivity.c */
+int fesd__ncp_call(fesd_ncp *ws, const double *z, double *raw, double *jac, fesd__ncp_stats *st);
+
+#endif

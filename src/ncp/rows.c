@@ -1,0 +1,149 @@
+/* Row selection: assembled row order, chain-rule weights, the map from each raw
+ * Jacobian entry to its position in the assembled matrix, and the symbolic
+ * analysis of the linear solver for the resulting pattern. */
+#include "ncp/ncp_internal.h"
+
+#include <string.h>
+
+/* Sort the entries (r[t], c[t]) of an nrows x ncols matrix into CSC form (rows
+ * ascending within a column, duplicates merged, as UMFPACK/KLU/CHOLMOD require);
+ * tgt[t] receives the position of entry t. Two stable counting sorts (by row,
+ * then by column), so the cost is linear. work: max(nrows, ncols) + 1 + 2 ne. */
+static void build_csc(int nrows, int ncols, int ne, const int *r, const int *c, int *p, int *idx,
+                      int *tgt, int *work) {
+  int *cnt = work;
+  int *by_row = work + (nrows > ncols ? nrows : ncols) + 1;
+  int *by_col = by_row + ne;
+
+  memset(cnt, 0, ((size_t)nrows + 1) * sizeof *cnt);
+  for (int t = 0; t < ne; t++) cnt[r[t] + 1]++;
+  for (int i = 0; i < nrows; i++) cnt[i + 1] += cnt[i];
+  for (int t = 0; t < ne; t++) by_row[cnt[r[t]]++] = t;
+
+  memset(p, 0, ((size_t)ncols + 1) * sizeof *p);
+  for (int t = 0; t < ne; t++) p[c[t] + 1]++;
+  for (int j = 0; j < ncols; j++) p[j + 1] += p[j];
+  memcpy(cnt, p, (size_t)ncols * sizeof *cnt);
+  for (int k = 0; k < ne; k++) {
+    int t = by_row[k];
+    by_col[cnt[c[t]]++] = t;
+  }
+
+  int k = 0, nz = 0;
+  for (int j = 0; j < ncols; j++) {
+    int end = p[j + 1], first = nz;
+    p[j] = nz;
+    for (; k < end; k++) {
+      int t = by_col[k];
+      if (nz > first && idx[nz - 1] == r[t]) {
+        tgt[t] = nz - 1;
+      } else {
+        idx[nz] = r[t];
+        tgt[t] = nz++;
+      }
+    }
+  }
+  p[ncols] = nz;
+}
+
+/* Assembled row of raw row rr under the current selection, or -1. */
+static int assembled_row(const fesd_ncp *ws, const int *eq_pos, int rr) {
+  if (rr < ws->n_eq) return ws->eq_on[rr] ? eq_pos[rr] : -1;
+  int k = rr - ws->n_eq, second = 0;
+  if (k >= ws->n_pair) {
+    k -= ws->n_pair;
+    second = 1;
+  }
+  switch (ws->pair_mode[k]) {
+  case FESD_NCP_PAIR_FB: return ws->pair_pos[k];
+  case FESD_NCP_PAIR_PIN: return ws->pair_pos[k] + second;
+  case FESD_NCP_PAIR_A: return second ? -1 : ws->pair_pos[k];
+  case FESD_NCP_PAIR_B: return second ? ws->pair_pos[k] : -1;
+  default: return -1;
+  }
+}
+
+int fesd__ncp_apply_rows(fesd_ncp *ws) {
+  const int n = ws->n, n_eq = ws->n_eq, np = ws->n_pair;
+  int *eq_pos = ws->work; /* scratch, consumed before build_csc reuses work */
+  int i = 0;
+
+  ws->ready = 0;
+  ws->n_eq_on = 0;
+  for (int e = 0; e < n_eq; e++) {
+    ws->wgt[e] = ws->eq_on[e] ? 1.0 : 0.0;
+    if (ws->eq_on[e]) {
+      eq_pos[e] = i++;
+      ws->eq_list[ws->n_eq_on++] = e;
+    }
+  }
+  ws->n_fb = 0;
+  for (int k = 0; k < np; k++) {
+    double wa = 0.0, wb = 0.0;
+    ws->pair_pos[k] = -1;
+    if (ws->pair_mode[k] == FESD_NCP_PAIR_FB) {
+      ws->pair_pos[k] = i++;
+      ws->fb_list[ws->n_fb++] = k;
+    } else if (ws->pair_mode[k] == FESD_NCP_PAIR_PIN) {
+      ws->pair_pos[k] = i;
+      i += 2;
+      wa = wb = 1.0;
+    } else if (ws->pair_mode[k] == FESD_NCP_PAIR_A) {
+      ws->pair_pos[k] = i++;
+      wa = 1.0;
+    } else if (ws->pair_mode[k] == FESD_NCP_PAIR_B) {
+      ws->pair_pos[k] = i++;
+      wb = 1.0;
+    }
+    ws->wgt[n_eq + k] = wa; /* FB weights are refreshed at every assembly */
+    ws->wgt[n_eq + np + k] = wb;
+  }
+  ws->m = i;
+
+  /* Square systems use the LU object when there is one; otherwise LM. */
+  if (ws->m == n && ws->lu) {
+    ws->active = ws->lu;
+  } else {
+    if (!ws->normal) {
+      int rc = fesd__ls_cholmod_create(&ws->normal, n);
+      if (rc != FESD_OK) return rc;
+    }
+    ws->active = ws->normal;
+  }
+
+  ws->n_act = 0;
+  for (int t = 0; t < ws->nnz; t++) {
+    int ar = assembled_row(ws, eq_pos, ws->trow[t]);
+    if (ar < 0) continue;
+    int a = ws->n_act++;
+    ws->act_src[a] = t;
+    ws->act_wrow[a] = ws->trow[t];
+    ws->act_r[a] = ar;
+    ws->act_c[a] = ws->tcol[t];
+  }
+
+  int rc;
+  switch (ws->active->ops->layout) {
+  case FESD__LAYOUT_DENSE:
+    for (int a = 0; a < ws->n_act; a++) ws->act_tgt[a] = ws->act_r[a] + ws->act_c[a] * ws->m;
+    ws->nvals = ws->m * n;
+    /* the dense normal object also serves as the square fallback: keep both current */
+    rc = ws->lu->ops->analyze(ws->lu, ws->m, NULL, NULL);
+    if (rc == FESD_OK) rc = ws->normal->ops->analyze(ws->normal, ws->m, NULL, NULL);
+    break;
+  case FESD__LAYOUT_CSC:
+    build_csc(ws->m, n, ws->n_act, ws->act_r, ws->act_c, ws->sp_p, ws->sp_i, ws->act_tgt,
+              ws->work);
+    ws->nvals = ws->sp_p[n];
+    rc = ws->active->ops->analyze(ws->active, ws->m, ws->sp_p, ws->sp_i);
+    break;
+  default: /* CSC of J' */
+    build_csc(n, ws->m, ws->n_act, ws->act_c, ws->act_r, ws->sp_p, ws->sp_i, ws->act_tgt,
+              ws->work);
+    ws->nvals = ws->sp_p[ws->m];
+    rc = ws->active->ops->analyze(ws->active, ws->m, ws->sp_p, ws->sp_i);
+    break;
+  }
+  if (rc == FESD_OK) ws->ready = 1;
+  return rc;
+}
