@@ -171,6 +171,15 @@ typedef struct {
 /** @brief Element data of the last accepted step (pointers valid until the next step). */
 FESD_API int fesd_last_step_data(const fesd_integrator *it, fesd_step_data *data);
 
+/**
+ * @brief Dense output inside the last accepted step from the collocation polynomial of
+ *        its element (Radau IIA, Gauss-Legendre, Lobatto IIIA; order s + 1 locally,
+ *        exact at the element ends up to the method's error).
+ * @return FESD_OK; FESD_ERR_INVALID_ARG if t is outside the last step or the method has no
+ *         collocation polynomial (Lobatto IIIC, explicit RK); FESD_ERR_NOT_READY before a step.
+ */
+FESD_API int fesd_dense_output(const fesd_integrator *it, double t, double *x);
+
 /** Accumulated statistics since fesd_set_state. */
 typedef struct {
   int steps, switch_steps, newton_iter, factorizations, solves, homotopy_stages, splits;

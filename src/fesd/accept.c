@@ -168,6 +168,7 @@ int fesd__accept(fesd_integrator *it, const double *z, const double *u, double T
       memcpy(it->rec_th + ((size_t)e * s + j) * nth, z + fesd__th(S, n, j), (size_t)nth * sizeof(double));
       memcpy(it->rec_la + ((size_t)e * s + j) * nth, z + fesd__la(S, n, j), (size_t)nth * sizeof(double));
       memcpy(it->rec_mu + ((size_t)e * s + j) * nsys, z + fesd__mu(S, n, j), (size_t)nsys * sizeof(double));
+      memcpy(it->rec_v + ((size_t)e * s + j) * nx, z + fesd__v(S, n, j), (size_t)nx * sizeof(double));
     }
     /* events at the left boundary of element n */
     for (int k = 0; k < nsys; k++) {

@@ -46,7 +46,7 @@ void fesd_free(fesd_integrator **itp) {
                     it->raw, it->jac, it->lb, it->ub, it->bk_x, it->bk_lam, it->bk_th, it->bk_zws,
                     it->bk_Sx, it->bk_Su, it->bk_ldp, it->Sx, it->Su, it->draw, it->dz, it->Dtmp,
                     it->Stmp, it->gbuf, it->blk, it->pt_t, it->pt_q, it->pt_l, it->rec_h, it->rec_t,
-                    it->rec_x, it->rec_th, it->rec_la, it->rec_mu};
+                    it->rec_x, it->rec_th, it->rec_la, it->rec_mu, it->rec_v};
   for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); i++) free(bufs[i]);
   free(it->eq_active);
   free(it->pair_mode);
@@ -95,6 +95,8 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
     return st;
   }
   fesd__system *S = &it->sys;
+  it->tab = tab;
+  fesd_tableau_get(FESD_RK_GAUSS_LEGENDRE, tab.s, &it->quad);
   it->n = S->n;
   it->nx = model->nx;
   it->nu = model->nu;
@@ -146,6 +148,7 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   it->rec_th = dalloc(cap * s * nth, &fail);
   it->rec_la = dalloc(cap * s * nth, &fail);
   it->rec_mu = dalloc(cap * s * (size_t)it->nsys, &fail);
+  it->rec_v = dalloc(cap * s * nx, &fail);
   it->eq_active = malloc((size_t)S->n_eq);
   it->pair_mode = malloc((size_t)(S->n_pair > 0 ? S->n_pair : 1));
   it->pt_src = malloc((N * (s + 1) + 1) * sizeof(int));
@@ -322,5 +325,37 @@ int fesd_dims(const fesd_integrator *it, int *n_theta, int *nsys) {
   if (!it) return FESD_ERR_NULL;
   if (n_theta) *n_theta = it->nth;
   if (nsys) *nsys = it->nsys;
+  return FESD_OK;
+}
+
+/* Dense output: on element n the collocation polynomial u(t_n + tau h) = x_n +
+ * h sum_j (int_0^tau l_j) v_j, l_j the Lagrange basis on the nodes c; the integrals by an
+ * s-point Gauss rule on [0, tau] (exact: degree s - 1). */
+int fesd_dense_output(const fesd_integrator *it, double t, double *x) {
+  if (!it || !x) return FESD_ERR_NULL;
+  const fesd_tableau *T = &it->tab;
+  int colloc = T->family == FESD_RK_RADAU_IIA || T->family == FESD_RK_GAUSS_LEGENDRE ||
+               T->family == FESD_RK_LOBATTO_IIIA;
+  if (!colloc) return FESD_ERR_INVALID_ARG;
+  if (it->n_el == 0) return FESD_ERR_NOT_READY;
+  const double t0 = it->rec_t[0], t1 = it->rec_t[it->n_el];
+  const double tol = 1e-12 * fmax(1.0, fabs(t1));
+  if (!(t >= t0 - tol && t <= t1 + tol)) return FESD_ERR_INVALID_ARG;
+  int e = 0;
+  while (e + 1 < it->n_el && t >= it->rec_t[e + 1]) e++;
+  const int s = T->s, nx = it->nx;
+  const double h = it->rec_h[e], tau = h > 0 ? fmin(fmax((t - it->rec_t[e]) / h, 0.0), 1.0) : 0.0;
+  memcpy(x, it->rec_x + (size_t)e * nx, (size_t)nx * sizeof(double));
+  for (int j = 0; j < s; j++) {
+    double w = 0; /* int_0^tau l_j */
+    for (int q = 0; q < it->quad.s; q++) {
+      double sg = tau * it->quad.c[q], l = 1;
+      for (int m = 0; m < s; m++)
+        if (m != j) l *= (sg - T->c[m]) / (T->c[j] - T->c[m]);
+      w += tau * it->quad.b[q] * l;
+    }
+    const double *v = it->rec_v + ((size_t)e * s + j) * nx;
+    for (int r = 0; r < nx; r++) x[r] += h * w * v[r];
+  }
   return FESD_OK;
 }

@@ -36,7 +36,8 @@ struct fesd_integrator {
   int jump_in, jump_out; /* switch exactly at the step start (mode entering, mode left), or -1 */
   /* records of the last accepted step */
   int cap_el, n_el;
-  double *rec_h, *rec_t, *rec_x, *rec_th, *rec_la, *rec_mu;
+  double *rec_h, *rec_t, *rec_x, *rec_th, *rec_la, *rec_mu, *rec_v;
+  fesd_tableau tab, quad; /* the method, and a Gauss rule for dense output */
   fesd_event events[FESD_MAX_EVENTS_PER_STEP];
   int n_events;
   fesd_stats stats;
