@@ -72,6 +72,30 @@ int main(void) {
     printf("slide-exit-2d s=%d: state error %.1e .. %.1e (order %.2f), exit time error %.1e .. %.1e "
            "(order %.2f)\n", s, ex[0], ex[ng - 1], px, et[0], et[ng - 1], pt);
   }
+  /* No regression: on problems without sliding exits the option changes nothing, neither
+   * the result nor the Newton iterations (within 10 %). */
+  const char *probs[] = {"oscillator", "sign-a", "sign-b", "ocp-dynamics"};
+  for (int p = 0; p < 4; p++)
+    for (int s = 2; s <= 3; s++) {
+      fesd_problem Q;
+      fesd_problem_get(probs[p], &Q);
+      int it_on, it_off;
+      double diff = 0;
+      static tu_run R2;
+      fesd_settings set;
+      fesd_settings_default(&set);
+      set.stages = s;
+      int st1 = tu_integrate(&Q, &set, 40, Q.T, &R);
+      it_on = R.stats.newton_iter;
+      set.exit_rows = 0;
+      int st2 = tu_integrate(&Q, &set, 40, Q.T, &R2);
+      it_off = R2.stats.newton_iter;
+      for (int i = 0; i < Q.model.nx; i++) diff = fmax(diff, fabs(R.xT[i] - R2.xT[i]));
+      TU_CHECK(!st1 && !st2 && diff <= 1e-14 && abs(it_on - it_off) <= 0.1 * it_off,
+               "%s s=%d: exit rows on/off differ: |dx| %.1e, iterations %d vs %d", probs[p], s, diff, it_on, it_off);
+      printf("%-12s s=%d N_sim=40: exit rows on/off: |x(T) difference| %.1e, Newton iterations %d / %d\n",
+             probs[p], s, diff, it_on, it_off);
+    }
   printf("%d failures\n", fails);
   return fails != 0;
 }
