@@ -97,6 +97,7 @@ static int chain_sensitivities(fesd_integrator *it, const double *z) {
   fesd__system_param_jac(S, z, it->draw);
   S->want_u = 0;
   st = fesd_ncp_sensitivity(it->ncp, z, 0.0, np, it->draw, it->dz);
+  if (st == FESD_ERR_CALLBACK && S->status) st = S->status; /* the model's own status */
   if (st) return st;
   /* D = rows of x_N in dz: nx x np */
   const int xN = S->xo[S->N - 1];
@@ -179,6 +180,12 @@ int fesd__accept(fesd_integrator *it, const double *z, const double *u, double T
     }
     t += z[S->ho[n]];
   }
+  /* a mode that drops out exactly at the step end (a sliding exit on the step grid): its
+   * theta vanishes only at the last stage, so the next step starts without it and neither
+   * boundary comparison sees the change */
+  for (int k = 0; k < nsys; k++)
+    add_event(it, it->t + T, k, element_bits(it, z, N - 1, k),
+              active_bits(it, z + fesd__th(S, N - 1, s - 1), k));
   it->rec_t[it->n_el] = it->t + T;
   memcpy(it->rec_x + (size_t)it->n_el * nx, z + S->xo[N - 1], (size_t)nx * sizeof(double));
   /* state */

@@ -25,6 +25,57 @@ void fesd__act_from_theta(const fesd_integrator *it, const double *theta, unsign
   }
 }
 
+/* x0 on a switching surface (several modes tie for min g): taking all tied modes active
+ * means sliding, whose DAE has no solution when every field crosses the surface the same
+ * way (e.g. both point outwards: equal normal components, singular in theta). A tied
+ * mode i whose field keeps it the strict minimum, d/dt (g_j - g_i) > 0 along the total
+ * field with f_i for every other tied j, is entered alone when it is the only such mode
+ * (a crossing); otherwise (sliding, or a non-unique spontaneous switch) all stay active.
+ * The other subsystems contribute with uniform weights on their tied modes. */
+static int resolve_ties(fesd_integrator *it, const double *u, unsigned char *a) {
+  fesd__model *m = &it->model;
+  const int nx = m->nx, nth = m->nth;
+  fesd__point_eval pe = {0};
+  pe.F = it->sys.pe[0].F;
+  pe.g = it->sys.pe[0].g;
+  pe.dgdx = it->sys.pe[0].dgdx;
+  int st = fesd__model_eval(m, it->x, u, &pe);
+  if (st) return st;
+  double *ftot = it->gbuf + nth; /* nx */
+  memset(ftot, 0, (size_t)nx * sizeof(double));
+  for (int k = 0; k < m->nsys; k++) {
+    int cnt = 0;
+    for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) cnt += a[i];
+    for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++)
+      if (a[i])
+        for (int r = 0; r < nx; r++) ftot[r] += pe.F[i * nx + r] / cnt;
+  }
+  for (int k = 0; k < m->nsys; k++) {
+    int cnt = 0, pick = -1, n_ok = 0;
+    for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) cnt += a[i];
+    if (cnt < 2) continue;
+    for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) {
+      if (!a[i]) continue;
+      int ok = 1;
+      for (int j = m->th_off[k]; j < m->th_off[k + 1] && ok; j++) {
+        if (j == i || !a[j]) continue;
+        double d = 0;
+        for (int r = 0; r < nx; r++) {
+          double f = ftot[r] + pe.F[i * nx + r];
+          for (int l = m->th_off[k]; l < m->th_off[k + 1]; l++)
+            if (a[l]) f -= pe.F[l * nx + r] / cnt;
+          d += (pe.dgdx[r * nth + j] - pe.dgdx[r * nth + i]) * f;
+        }
+        ok = d > 0;
+      }
+      if (ok) pick = i, n_ok++;
+    }
+    if (n_ok == 1)
+      for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) a[i] = i == pick;
+  }
+  return FESD_OK;
+}
+
 /* Active set at the step start: the previous step's last stage, or the argmin of g. */
 int fesd__act_start(fesd_integrator *it, const double *u, unsigned char *a) {
   if (it->have_prev_theta) {
@@ -34,13 +85,16 @@ int fesd__act_start(fesd_integrator *it, const double *u, unsigned char *a) {
   fesd__model *m = &it->model;
   int st = fesd__model_g(m, it->x, u, it->gbuf);
   if (st) return st;
+  int tied = 0;
   for (int k = 0; k < m->nsys; k++) {
     double gmin = INFINITY;
     for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) gmin = fmin(gmin, it->gbuf[i]);
     double tie = 1e-12 * fmax(1.0, fabs(gmin));
-    for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) a[i] = it->gbuf[i] <= gmin + tie;
+    int cnt = 0;
+    for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) cnt += a[i] = it->gbuf[i] <= gmin + tie;
+    tied |= cnt > 1;
   }
-  return FESD_OK;
+  return tied ? resolve_ties(it, u, a) : FESD_OK;
 }
 
 /* theta restricted to the active set of each element, renormalised per subsystem; a
@@ -154,4 +208,57 @@ int fesd__find_violation(fesd_integrator *it, const double *z, const unsigned ch
     }
   }
   return v->found;
+}
+
+/* Signs between the stage points. Cross complementarity only sees the stage points, so an
+ * element can pass through a region its active set does not own (a short excursion, or the
+ * many switches of a Zeno accumulation) and still converge: a wrong answer. The collocation
+ * polynomial u(tau) = x_n + h sum_j (int_0^tau l_j) v_j is checked at the midpoints between
+ * its nodes 0, c_1..c_s (, 1): some inactive mode's indicator below every active one by more
+ * than 1e3 cc_tol (interpolation error allowance) rejects the step, which is then halved. */
+int fesd__interior_check(fesd_integrator *it, const double *z) {
+  const fesd_tableau *T = &it->tab;
+  if (T->family != FESD_RK_RADAU_IIA && T->family != FESD_RK_GAUSS_LEGENDRE &&
+      T->family != FESD_RK_LOBATTO_IIIA)
+    return FESD_OK;
+  fesd__system *S = &it->sys;
+  const fesd__model *m = &it->model;
+  const int s = S->s, nx = S->nx, nth = S->nth;
+  const double tol = 1e3 * it->set.cc_tol;
+  double *g = it->gbuf, *x = it->gbuf + nth, nodes[FESD_RK_MAX_STAGES + 2];
+  int nn = 0;
+  nodes[nn++] = 0.0;
+  for (int j = 0; j < s; j++)
+    if (T->c[j] > nodes[nn - 1]) nodes[nn++] = T->c[j];
+  if (nodes[nn - 1] < 1.0) nodes[nn++] = 1.0;
+  for (int n = 0; n < S->N; n++) {
+    const double *xn = n == 0 ? S->x0 : z + S->xo[n - 1], h = z[S->ho[n]];
+    for (int p = 0; p + 1 < nn; p++) {
+      const double tau = 0.5 * (nodes[p] + nodes[p + 1]);
+      memcpy(x, xn, (size_t)nx * sizeof(double));
+      for (int j = 0; j < s; j++) {
+        double w = 0; /* int_0^tau l_j by the Gauss rule (exact) */
+        for (int q = 0; q < it->quad.s; q++) {
+          double sg = tau * it->quad.c[q], l = 1;
+          for (int r = 0; r < s; r++)
+            if (r != j) l *= (sg - T->c[r]) / (T->c[j] - T->c[r]);
+          w += tau * it->quad.b[q] * l;
+        }
+        for (int r = 0; r < nx; r++) x[r] += h * w * z[fesd__v(S, n, j) + r];
+      }
+      int st = fesd__model_g(&it->model, x, S->u, g);
+      if (st) return st;
+      for (int k = 0; k < m->nsys; k++) {
+        double gact = INFINITY, gin = INFINITY;
+        for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) {
+          int act = 0;
+          for (int j = 0; j < s; j++) act |= z[fesd__th(S, n, j) + i] > it->set.active_tol;
+          if (act) gact = fmin(gact, g[i]);
+          else gin = fmin(gin, g[i]);
+        }
+        if (gin < gact - tol) return FESD_ERR_STEP_FAILED;
+      }
+    }
+  }
+  return FESD_OK;
 }

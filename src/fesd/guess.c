@@ -22,12 +22,19 @@ int fesd__consistent_guess(fesd_integrator *it, double *z) {
   for (int n = 0; n < S->N; n++) {
     const double *xn = n == 0 ? S->x0 : z + S->xo[n - 1];
     double h = z[S->ho[n]];
-    for (int sweep = 0; sweep < (S->tab.is_explicit ? s : 3); sweep++)
+    /* The sweeps contract only if h |A| |dF/dx| < 1. A stiff mode makes them diverge (the
+     * guess overflows and Newton fails), so when a sweep changes v clearly more than the
+     * previous one, the stages are frozen at x_n for a last sweep: v_j = F(x_n) theta_j. */
+    const int n_sweep = S->tab.is_explicit ? s : 3;
+    int frozen = 0;
+    double prev = INFINITY;
+    for (int sweep = 0; sweep < n_sweep; sweep++) {
+      double change = 0;
       for (int j = 0; j < s; j++) {
         for (int r = 0; r < nx; r++) {
           double acc = 0;
           for (int l = 0; l < s; l++) acc += S->tab.A[j][l] * z[fesd__v(S, n, l) + r];
-          X[r] = xn[r] + h * acc;
+          X[r] = xn[r] + (frozen ? 0.0 : h * acc);
         }
         int st = fesd__model_eval(m, X, S->u, &pe);
         if (st) return st;
@@ -36,6 +43,7 @@ int fesd__consistent_guess(fesd_integrator *it, double *z) {
         for (int r = 0; r < nx; r++) {
           double acc = 0;
           for (int i = 0; i < nth; i++) acc += F[i * nx + r] * th[i];
+          change = fmax(change, fabs(acc - v[r]));
           v[r] = acc;
         }
         for (int k = 0; k < m->nsys; k++) {
@@ -45,6 +53,12 @@ int fesd__consistent_guess(fesd_integrator *it, double *z) {
         }
         for (int i = 0; i < nth; i++) la[i] = g[i] - mu[m->sys_of[i]];
       }
+      if (!frozen && !S->tab.is_explicit && !(change <= 2 * prev || change <= 1e-10)) {
+        frozen = 1;
+        sweep = n_sweep - 2; /* one more (frozen) sweep */
+      }
+      prev = change;
+    }
     for (int r = 0; r < nx; r++) {
       double acc = 0;
       for (int j = 0; j < s; j++) acc += S->tab.b[j] * z[fesd__v(S, n, j) + r];

@@ -43,11 +43,14 @@ void fesd_free(fesd_integrator **itp) {
   fesd__system_free(&it->sys);
   fesd__model_free(&it->model);
   double *bufs[] = {it->x, it->lam00, it->theta_prev, it->u_cur, it->z, it->zws, it->z0, it->zpred,
-                    it->raw, it->jac, it->lb, it->ub, it->bk_x, it->bk_lam, it->bk_th, it->bk_zws,
-                    it->bk_Sx, it->bk_Su, it->bk_ldp, it->Sx, it->Su, it->draw, it->dz, it->Dtmp,
+                    it->raw, it->jac, it->lb, it->ub, it->Sx, it->Su, it->draw, it->dz, it->Dtmp,
                     it->Stmp, it->gbuf, it->blk, it->pt_t, it->pt_q, it->pt_l, it->rec_h, it->rec_t,
                     it->rec_x, it->rec_th, it->rec_la, it->rec_mu, it->rec_v};
   for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); i++) free(bufs[i]);
+  for (fesd__saved *b = &it->bk; b <= &it->bk_sub; b++) {
+    double *saved[] = {b->x, b->lam, b->th, b->zws, b->Sx, b->Su, b->ldp};
+    for (size_t i = 0; i < sizeof(saved) / sizeof(saved[0]); i++) free(saved[i]);
+  }
   free(it->eq_active);
   free(it->pair_mode);
   free(it->pt_src);
@@ -120,13 +123,15 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   it->jac = dalloc((size_t)S->nnz, &fail);
   it->lb = dalloc(n, &fail);
   it->ub = dalloc(n, &fail);
-  it->bk_x = dalloc(nx, &fail);
-  it->bk_lam = dalloc(nth, &fail);
-  it->bk_th = dalloc(nth, &fail);
-  it->bk_zws = dalloc(n, &fail);
-  it->bk_Sx = dalloc(nx * nx, &fail);
-  it->bk_Su = dalloc(nx * nu, &fail);
-  it->bk_ldp = dalloc(nth * np, &fail);
+  for (fesd__saved *b = &it->bk; b <= &it->bk_sub; b++) {
+    b->x = dalloc(nx, &fail);
+    b->lam = dalloc(nth, &fail);
+    b->th = dalloc(nth, &fail);
+    b->zws = dalloc(n, &fail);
+    b->Sx = dalloc(nx * nx, &fail);
+    b->Su = dalloc(nx * nu, &fail);
+    b->ldp = dalloc(nth * np, &fail);
+  }
   it->Sx = dalloc(nx * nx, &fail);
   it->Su = dalloc(nx * nu, &fail);
   if (settings->sensitivities) {
@@ -198,32 +203,36 @@ int fesd_set_state(fesd_integrator *it, double t0, const double *x0, const doubl
   return st;
 }
 
-static void backup(fesd_integrator *it, double *t, int *flags) {
+void fesd__save(fesd_integrator *it, fesd__saved *b) {
   const size_t nx = (size_t)it->nx, nth = (size_t)it->nth, nu = (size_t)it->nu;
-  *t = it->t;
-  flags[0] = it->have_ws;
-  flags[1] = it->have_prev_theta;
-  memcpy(it->bk_x, it->x, nx * sizeof(double));
-  memcpy(it->bk_lam, it->lam00, nth * sizeof(double));
-  memcpy(it->bk_th, it->theta_prev, nth * sizeof(double));
-  memcpy(it->bk_zws, it->zws, (size_t)it->n * sizeof(double));
-  memcpy(it->bk_Sx, it->Sx, nx * nx * sizeof(double));
-  memcpy(it->bk_Su, it->Su, nx * nu * sizeof(double));
-  memcpy(it->bk_ldp, it->sys.lam00_dp, nth * (size_t)it->np * sizeof(double));
+  b->t = it->t;
+  b->have_ws = it->have_ws;
+  b->have_prev_theta = it->have_prev_theta;
+  b->n_el = it->n_el;
+  b->n_events = it->n_events;
+  memcpy(b->x, it->x, nx * sizeof(double));
+  memcpy(b->lam, it->lam00, nth * sizeof(double));
+  memcpy(b->th, it->theta_prev, nth * sizeof(double));
+  memcpy(b->zws, it->zws, (size_t)it->n * sizeof(double));
+  memcpy(b->Sx, it->Sx, nx * nx * sizeof(double));
+  memcpy(b->Su, it->Su, nx * nu * sizeof(double));
+  memcpy(b->ldp, it->sys.lam00_dp, nth * (size_t)it->np * sizeof(double));
 }
 
-static void restore(fesd_integrator *it, double t, const int *flags) {
+void fesd__load(fesd_integrator *it, const fesd__saved *b) {
   const size_t nx = (size_t)it->nx, nth = (size_t)it->nth, nu = (size_t)it->nu;
-  it->t = t;
-  it->have_ws = flags[0];
-  it->have_prev_theta = flags[1];
-  memcpy(it->x, it->bk_x, nx * sizeof(double));
-  memcpy(it->lam00, it->bk_lam, nth * sizeof(double));
-  memcpy(it->theta_prev, it->bk_th, nth * sizeof(double));
-  memcpy(it->zws, it->bk_zws, (size_t)it->n * sizeof(double));
-  memcpy(it->Sx, it->bk_Sx, nx * nx * sizeof(double));
-  memcpy(it->Su, it->bk_Su, nx * nu * sizeof(double));
-  memcpy(it->sys.lam00_dp, it->bk_ldp, nth * (size_t)it->np * sizeof(double));
+  it->t = b->t;
+  it->have_ws = b->have_ws;
+  it->have_prev_theta = b->have_prev_theta;
+  it->n_el = b->n_el;
+  it->n_events = b->n_events;
+  memcpy(it->x, b->x, nx * sizeof(double));
+  memcpy(it->lam00, b->lam, nth * sizeof(double));
+  memcpy(it->theta_prev, b->th, nth * sizeof(double));
+  memcpy(it->zws, b->zws, (size_t)it->n * sizeof(double));
+  memcpy(it->Sx, b->Sx, nx * nx * sizeof(double));
+  memcpy(it->Su, b->Su, nx * nu * sizeof(double));
+  memcpy(it->sys.lam00_dp, b->ldp, nth * (size_t)it->np * sizeof(double));
 }
 
 int fesd_step(fesd_integrator *it, const double *u, double T, fesd_step_info *info) {
@@ -236,22 +245,19 @@ int fesd_step(fesd_integrator *it, const double *u, double T, fesd_step_info *in
   if (!(T > 0) || !isfinite(T)) return info->status = FESD_ERR_INVALID_ARG;
   for (int i = 0; i < it->nu; i++)
     if (!isfinite(u[i])) return info->status = FESD_ERR_INVALID_ARG;
-  double t0 = fesd__wall_time(), tb;
-  int flags[2];
-  backup(it, &tb, flags);
+  double t0 = fesd__wall_time();
   it->n_el = 0;
   it->n_events = 0;
+  fesd__save(it, &it->bk);
   it->model.failed = NULL;
   int st = fesd__substep(it, u, T, 0, info);
   info->time = fesd__wall_time() - t0;
   info->status = st;
+  if (st != FESD_ERR_CALLBACK && st != FESD_ERR_NONFINITE) info->failed_callback = NULL;
   if (st != FESD_OK) {
-    info->failed_time = it->t;
-    if (!info->failed_callback && (st == FESD_ERR_CALLBACK || st == FESD_ERR_NONFINITE))
-      info->failed_callback = it->model.failed;
-    restore(it, tb, flags);
-    it->n_el = 0;
-    it->n_events = 0;
+    info->failed_time = it->t; /* start of the sub-step that failed */
+    if (st == FESD_ERR_CALLBACK || st == FESD_ERR_NONFINITE) info->failed_callback = it->model.failed;
+    fesd__load(it, &it->bk); /* the state is unchanged; no records */
     return st;
   }
   fesd_stats *S = &it->stats;

@@ -9,6 +9,14 @@
 
 #define FESD_MAX_EVENTS_PER_STEP 256
 
+/* A saved state (integrator.c): the step start, restored when fesd_step fails, and the start
+ * of a sub-step attempt, restored before halving (a failure inside accept, e.g. a callback
+ * at the new state, can leave the state half-updated). */
+typedef struct {
+  double t, *x, *lam, *th, *zws, *Sx, *Su, *ldp;
+  int have_ws, have_prev_theta, n_el, n_events;
+} fesd__saved;
+
 struct fesd_integrator {
   fesd_settings set;
   fesd__model model;
@@ -22,8 +30,7 @@ struct fesd_integrator {
   /* step data */
   double *z, *zws, *z0, *zpred, *raw, *jac, *lb, *ub;
   unsigned char *eq_active, *pair_mode;
-  /* backup of the state for a failed fesd_step (restored: the state stays unchanged) */
-  double *bk_x, *bk_lam, *bk_th, *bk_zws, *bk_Sx, *bk_Su, *bk_ldp;
+  fesd__saved bk, bk_sub; /* step start, sub-step start */
   /* sensitivities */
   double *Sx, *Su, *draw, *dz, *Dtmp, *Stmp;
   double *gbuf, *blk;
@@ -43,5 +50,8 @@ struct fesd_integrator {
   fesd_stats stats;
   double sum_iter_ord, sum_iter_sw;
 };
+
+void fesd__save(fesd_integrator *it, fesd__saved *b);
+void fesd__load(fesd_integrator *it, const fesd__saved *b);
 
 #endif

@@ -64,19 +64,21 @@ int fesd__model_init(fesd__model *m, const fesd_model *u) {
   if (!m->nf || !m->nc || !m->th_off || !m->S) goto fail;
   for (int k = 0; k < K; k++) {
     int nf = u->n_modes[k], nc = u->n_switch ? u->n_switch[k] : 0;
-    if (nf < 2 || nc < 0 || nc > 30) {
+    if (nf < 2 || nc < 0) {
       st = FESD_ERR_MODEL;
+      goto fail;
+    }
+    const signed char *given = u->sign ? u->sign[k] : NULL;
+    /* nc switching functions give 2^nc sign patterns: a full matrix needs nf == 2^nc, a
+     * given one (distinct rows) nf <= 2^nc */
+    if (nc > 30 || (nc > 0 && (given ? nf > (1 << nc) : nf != (1 << nc)))) {
+      st = FESD_ERR_DIMENSION;
       goto fail;
     }
     m->nf[k] = nf;
     m->nc[k] = nc;
     m->th_off[k + 1] = m->th_off[k] + nf;
     if (nc > 0) {
-      const signed char *given = u->sign ? u->sign[k] : NULL;
-      if (!given && nf != (1 << nc)) {
-        st = FESD_ERR_SIGN_MATRIX;
-        goto fail;
-      }
       m->S[k] = malloc((size_t)nf * (size_t)nc);
       if (!m->S[k]) goto fail;
       if (given)

@@ -18,6 +18,9 @@
 #include "fesd/integrator.h"
 #include "fesd/step.h"
 
+/* A callback failed (error code, NaN/Inf): no other path of this attempt can succeed. */
+static int cb_failed(int st) { return st == FESD_ERR_CALLBACK || st == FESD_ERR_NONFINITE; }
+
 /* ---------- row selections ---------- */
 
 static int rows_select(fesd_integrator *it, const int *switch_at) {
@@ -118,7 +121,7 @@ static int fb_path(fesd_integrator *it, double T, fesd_step_info *info) {
   if ((st = rows_select(it, NULL))) return st;
   memcpy(z, z0, (size_t)S->n * sizeof(double));
   st = solve(it, z, 0.0, tol, it->set.max_iter_first, 0, info);
-  if (st == FESD_ERR_CALLBACK) return st;
+  if (cb_failed(st)) return st;
   if (it->set.method == FESD_METHOD_STANDARD) {
     if (st != FESD_OK) {
       memcpy(z, z0, (size_t)S->n * sizeof(double));
@@ -135,7 +138,7 @@ static int fb_path(fesd_integrator *it, double T, fesd_step_info *info) {
     int ok = 0;
     for (double sigma = 1e-1; sigma >= 0.9e-3; sigma *= 0.1) {
       int s2 = solve(it, zp, sigma, 1e-2 * sigma, 20, 0, info);
-      if (s2 == FESD_ERR_CALLBACK) return s2;
+      if (cb_failed(s2)) return s2;
       ok = (s2 == FESD_OK) || ok;
       if (s2 != FESD_OK) break;
     }
@@ -143,13 +146,14 @@ static int fb_path(fesd_integrator *it, double T, fesd_step_info *info) {
   }
   double tc[16];
   int nc = fesd__predict_switches(it, zp, T, tc, 16);
-  if (nc == 0 || nc > S->N - 1) return FESD_ERR_TOO_MANY_SWITCHES;
+  if (nc == 0) return FESD_ERR_STEP_FAILED; /* no switch located: not a switch problem */
+  if (nc > S->N - 1) return FESD_ERR_TOO_MANY_SWITCHES;
   /* reduced square FESD system */
   if ((st = fesd__resort_guess(it, zp, T, tc, nc, it->sw_at, z0))) return st;
   if ((st = rows_select(it, it->sw_at))) return st;
   memcpy(z, z0, (size_t)S->n * sizeof(double));
   st = solve(it, z, 0.0, tol, it->set.max_iter, 0, info);
-  if (st == FESD_ERR_CALLBACK) return st;
+  if (cb_failed(st)) return st;
   if (st != FESD_OK || !fesd__valid(it, z, &ccm)) {
     memcpy(z, z0, (size_t)S->n * sizeof(double));
     st = solve(it, z, 0.0, tol, it->set.max_iter, 1, info);
@@ -220,7 +224,7 @@ static int active_path(fesd_integrator *it, double T, fesd_step_info *info) {
   if ((st = fesd__consistent_guess(it, z))) return st;
   st = active_solve(it, z, it->set.max_iter_first, &v, info);
   if (st == FESD_OK) return FESD_OK;
-  if (st != FESD_ERR_STEP_FAILED || !v.found) return st == FESD_ERR_CALLBACK ? st : FESD_ERR_STEP_FAILED;
+  if (st != FESD_ERR_STEP_FAILED || !v.found) return cb_failed(st) ? st : FESD_ERR_STEP_FAILED;
   if (it->set.method == FESD_METHOD_STANDARD) return FESD_ERR_STEP_FAILED;
   memcpy(zf, z, (size_t)S->n * sizeof(double));
   /* candidate active sets after the switch */
@@ -270,7 +274,7 @@ static int active_path(fesd_integrator *it, double T, fesd_step_info *info) {
     if ((st = fesd__consistent_guess(it, z))) return st;
     fesd__violation v2;
     st = active_solve(it, z, it->set.max_iter, &v2, info);
-    if (st == FESD_ERR_CALLBACK) return st;
+    if (cb_failed(st)) return st;
     if (st == FESD_OK) {
       info->switch_step = !at_start;
       /* a crossing or entry exactly at the step start: the step equations see no switch,
@@ -299,7 +303,7 @@ static int try_step(fesd_integrator *it, const double *u, double T, fesd_step_in
   if ((st = fesd__act_start(it, u, it->act0))) return st;
   it->jump_in = -1;
   st = active_path(it, T, info);
-  if (st == FESD_ERR_CALLBACK) return st;
+  if (cb_failed(st)) return st;
   if (st != FESD_OK) {
     st = fb_path(it, T, info);
     if (st) return st;
@@ -308,14 +312,19 @@ static int try_step(fesd_integrator *it, const double *u, double T, fesd_step_in
   }
   double ccm = 0;
   if (it->set.method == FESD_METHOD_FESD && !fesd__valid(it, it->z, &ccm)) return FESD_ERR_STEP_FAILED;
+  if (it->set.method == FESD_METHOD_FESD && (st = fesd__interior_check(it, it->z))) return st;
   info->cc_max = it->set.method == FESD_METHOD_FESD ? ccm : fesd__cc_max(S, it->z);
   return fesd__accept(it, it->z, u, T);
 }
 
 int fesd__substep(fesd_integrator *it, const double *u, double T, int depth, fesd_step_info *info) {
+  fesd__save(it, &it->bk_sub);
   int st = try_step(it, u, T, info);
-  if (st == FESD_OK || st == FESD_ERR_CALLBACK) return st;
-  if (depth >= it->set.max_splits) return st == FESD_ERR_TOO_MANY_SWITCHES ? st : FESD_ERR_STEP_FAILED;
+  if (st == FESD_OK) return st;
+  fesd__load(it, &it->bk_sub); /* accept may have failed half-way */
+  if (st == FESD_ERR_CALLBACK) return st;
+  if (depth >= it->set.max_splits)
+    return st == FESD_ERR_TOO_MANY_SWITCHES || st == FESD_ERR_NONFINITE ? st : FESD_ERR_STEP_FAILED;
   info->splits++;
   st = fesd__substep(it, u, 0.5 * T, depth + 1, info);
   if (st) return st;

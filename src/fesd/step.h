@@ -26,6 +26,8 @@ int fesd__rows_active(fesd_integrator *it, const unsigned char *act, const int *
                       const int *exit_mode);
 int fesd__find_violation(fesd_integrator *it, const double *z, const unsigned char *act,
                          fesd__violation *v);
+/* FESD_ERR_STEP_FAILED if the collocation polynomial enters a region between stage points. */
+int fesd__interior_check(fesd_integrator *it, const double *z);
 /* guess.c */
 int fesd__initial_guess(fesd_integrator *it, const double *u, double T, double *z);
 int fesd__consistent_guess(fesd_integrator *it, double *z);
