@@ -43,6 +43,30 @@ typedef int (*fesd_switch_fn)(int sys, const double *x, const double *u, double 
 typedef int (*fesd_switch_jac_fn)(int sys, const double *x, const double *u, double *dcdx,
                                   double *dcdu, void *user);
 
+/**
+ * Optional sparsity of one subsystem, for large n_x (all indices 0-based). With it the
+ * callbacks of that subsystem work on compressed data:
+ *  - field() writes n_rows values: the entries rows[0..n_rows-1] of f (all other entries of
+ *    f are zero);
+ *  - field_jac() writes jac_nnz values of df/dx at (rows[jac_row[e]], jac_col[e]) and
+ *    dfdu as an n_rows x nu column-major block;
+ *  - sw_jac() writes sw_nnz values of dc/dx (dg/dx when n_switch == 0) at
+ *    (sw_row[e], sw_col[e]) and dcdu as a dense (rows x nu) block.
+ * Patterns are unions over the modes of the subsystem. Jacobian callbacks are required
+ * (no finite differences for sparse models). The step system is then sparse and its cost
+ * grows with the number of nonzeros instead of n_x^2.
+ */
+typedef struct {
+  int n_rows;
+  const int *rows;     /**< ascending state indices */
+  int jac_nnz;
+  const int *jac_row;  /**< index into rows */
+  const int *jac_col;  /**< state index */
+  int sw_nnz;
+  const int *sw_row;   /**< switching-function (or indicator) index */
+  const int *sw_col;   /**< state index */
+} fesd_sparsity;
+
 /** Model description. Arrays are copied by fesd_create(). */
 typedef struct {
   int nx;                 /**< states (>= 1) */
@@ -59,6 +83,7 @@ typedef struct {
   fesd_switch_fn sw;            /**< required */
   fesd_switch_jac_fn sw_jac;    /**< optional: NULL = central finite differences */
   void *user;                   /**< passed to every callback */
+  const fesd_sparsity *sparsity; /**< [nsys] optional (NULL = dense callbacks) */
 } fesd_model;
 
 typedef enum {

@@ -13,9 +13,9 @@ int fesd__update_lambda00(fesd_integrator *it, const double *x, const double *u,
   fesd__point_eval pe = {0};
   pe.g = it->gbuf;
   double *dg = it->sys.lam00_dp; /* nth x (nx+nu) column-major */
-  double *dgdx = it->Dtmp, *dgdu = it->Dtmp + (size_t)nth * nx;
+  double *dgdu = it->pscr.dgdu, *t = it->vtmp;
   if (deriv) {
-    pe.dgdx = dgdx;
+    pe.dgdx = it->pscr.dgdx;
     pe.dgdu = nu > 0 ? dgdu : NULL;
   }
   int st = fesd__model_eval(m, x, u, &pe);
@@ -33,7 +33,10 @@ int fesd__update_lambda00(fesd_integrator *it, const double *x, const double *u,
     for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) {
       it->lam00[i] = fmax(it->gbuf[i] - gmin, 0.0);
       if (deriv) {
-        for (int c = 0; c < nx; c++) dg[c * nth + i] = dgdx[c * nth + i] - dgdx[c * nth + imin];
+        memset(t, 0, (size_t)nx * sizeof(double));
+        fesd__dg_axpy(m, &pe, i, 1.0, t);
+        fesd__dg_axpy(m, &pe, imin, -1.0, t);
+        for (int c = 0; c < nx; c++) dg[c * nth + i] = t[c];
         for (int c = 0; c < nu; c++)
           dg[(nx + c) * nth + i] = dgdu[c * nth + i] - dgdu[c * nth + imin];
       }
@@ -52,29 +55,25 @@ static int start_jump(fesd_integrator *it, const double *z) {
   fesd__model *m = &it->model;
   const int nx = m->nx, nu = m->nu, nth = m->nth, a = it->jump_in, b = it->jump_out;
   fesd__point_eval pe = {0};
-  pe.F = it->sys.pe[0].F;
-  pe.g = it->sys.pe[0].g;
-  pe.dgdx = it->sys.pe[0].dgdx;
-  pe.dgdu = nu > 0 ? it->sys.pe[0].dgdu : NULL;
+  pe.F = it->pscr.F;
+  pe.g = it->pscr.g;
+  pe.dgdx = it->pscr.dgdx;
+  pe.dgdu = nu > 0 ? it->pscr.dgdu : NULL;
   int st = fesd__model_eval(m, it->x, it->sys.u, &pe);
   if (st) return st;
   const double *th1 = z + fesd__th(&it->sys, 0, 0);
-  double *df = it->gbuf, den = 0; /* f+ - f- (nx) */
-  for (int r = 0; r < nx; r++) {
-    double fp = 0, fm = 0;
-    for (int i = 0; i < nth; i++) {
-      fp += pe.F[i * nx + r] * th1[i];
-      fm += pe.F[i * nx + r] * it->theta_prev[i];
-    }
-    df[r] = fp - fm;
-    den += (pe.dgdx[r * nth + a] - pe.dgdx[r * nth + b]) * fm;
+  double *df = it->vtmp, *fm = it->vtmp + nx; /* f+ - f-, f- */
+  memset(df, 0, 2 * (size_t)nx * sizeof(double));
+  for (int i = 0; i < nth; i++) {
+    fesd__F_axpy(m, &pe, i, th1[i] - it->theta_prev[i], df);
+    fesd__F_axpy(m, &pe, i, it->theta_prev[i], fm);
   }
+  double den = fesd__dg_dot(m, &pe, a, fm) - fesd__dg_dot(m, &pe, b, fm);
   if (fabs(den) < 1e-300) return FESD_OK; /* grazing: no transversal saltation */
   /* S <- S + df (grad psi' S) / den, column by column */
   for (int c = 0; c < nx + nu; c++) {
     double *col = c < nx ? it->Sx + (size_t)c * nx : it->Su + (size_t)(c - nx) * nx;
-    double gs = 0;
-    for (int r = 0; r < nx; r++) gs += (pe.dgdx[r * nth + a] - pe.dgdx[r * nth + b]) * col[r];
+    double gs = fesd__dg_dot(m, &pe, a, col) - fesd__dg_dot(m, &pe, b, col);
     if (c >= nx) gs += pe.dgdu[(c - nx) * nth + a] - pe.dgdu[(c - nx) * nth + b];
     for (int r = 0; r < nx; r++) col[r] += df[r] * gs / den;
   }

@@ -36,19 +36,18 @@ static int resolve_ties(fesd_integrator *it, const double *u, unsigned char *a) 
   fesd__model *m = &it->model;
   const int nx = m->nx, nth = m->nth;
   fesd__point_eval pe = {0};
-  pe.F = it->sys.pe[0].F;
-  pe.g = it->sys.pe[0].g;
-  pe.dgdx = it->sys.pe[0].dgdx;
+  pe.F = it->pscr.F;
+  pe.g = it->pscr.g;
+  pe.dgdx = it->pscr.dgdx;
   int st = fesd__model_eval(m, it->x, u, &pe);
   if (st) return st;
-  double *ftot = it->gbuf + nth; /* nx */
+  double *ftot = it->gbuf + nth, *f = it->vtmp; /* nx each */
   memset(ftot, 0, (size_t)nx * sizeof(double));
   for (int k = 0; k < m->nsys; k++) {
     int cnt = 0;
     for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) cnt += a[i];
     for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++)
-      if (a[i])
-        for (int r = 0; r < nx; r++) ftot[r] += pe.F[i * nx + r] / cnt;
+      if (a[i]) fesd__F_axpy(m, &pe, i, 1.0 / cnt, ftot);
   }
   for (int k = 0; k < m->nsys; k++) {
     int cnt = 0, pick = -1, n_ok = 0;
@@ -59,14 +58,12 @@ static int resolve_ties(fesd_integrator *it, const double *u, unsigned char *a) 
       int ok = 1;
       for (int j = m->th_off[k]; j < m->th_off[k + 1] && ok; j++) {
         if (j == i || !a[j]) continue;
-        double d = 0;
-        for (int r = 0; r < nx; r++) {
-          double f = ftot[r] + pe.F[i * nx + r];
-          for (int l = m->th_off[k]; l < m->th_off[k + 1]; l++)
-            if (a[l]) f -= pe.F[l * nx + r] / cnt;
-          d += (pe.dgdx[r * nth + j] - pe.dgdx[r * nth + i]) * f;
-        }
-        ok = d > 0;
+        /* total field with mode i alone in subsystem k */
+        memcpy(f, ftot, (size_t)nx * sizeof(double));
+        fesd__F_axpy(m, &pe, i, 1.0, f);
+        for (int l = m->th_off[k]; l < m->th_off[k + 1]; l++)
+          if (a[l]) fesd__F_axpy(m, &pe, l, -1.0 / cnt, f);
+        ok = fesd__dg_dot(m, &pe, j, f) - fesd__dg_dot(m, &pe, i, f) > 0;
       }
       if (ok) pick = i, n_ok++;
     }

@@ -15,9 +15,9 @@ int fesd__consistent_guess(fesd_integrator *it, double *z) {
   fesd__system *S = &it->sys;
   fesd__model *m = &it->model;
   const int nx = S->nx, nth = S->nth, s = S->s;
-  double *F = S->pe[0].F, *g = S->pe[0].g, *X = S->X;
+  double *g = it->pscr.g, *X = S->X;
   fesd__point_eval pe = {0};
-  pe.F = F;
+  pe.F = it->pscr.F;
   pe.g = g;
   for (int n = 0; n < S->N; n++) {
     const double *xn = n == 0 ? S->x0 : z + S->xo[n - 1];
@@ -40,12 +40,12 @@ int fesd__consistent_guess(fesd_integrator *it, double *z) {
         if (st) return st;
         const double *th = z + fesd__th(S, n, j);
         double *v = z + fesd__v(S, n, j), *la = z + fesd__la(S, n, j), *mu = z + fesd__mu(S, n, j);
-        for (int r = 0; r < nx; r++) {
-          double acc = 0;
-          for (int i = 0; i < nth; i++) acc += F[i * nx + r] * th[i];
-          change = fmax(change, fabs(acc - v[r]));
-          v[r] = acc;
-        }
+        double *vold = it->vtmp; /* the previous v, to measure the sweep's change */
+        memcpy(vold, v, (size_t)nx * sizeof(double));
+        memset(v, 0, (size_t)nx * sizeof(double));
+        for (int i = 0; i < nth; i++)
+          if (th[i] != 0.0) fesd__F_axpy(m, &pe, i, th[i], v);
+        for (int r = 0; r < nx; r++) change = fmax(change, fabs(v[r] - vold[r]));
         for (int k = 0; k < m->nsys; k++) {
           double num = 0, den = 0;
           for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) num += th[i] * g[i], den += th[i];
@@ -110,16 +110,12 @@ static int lp_block(fesd_integrator *it, const double *x, const double *u, doubl
     }
     mu[k] = gmin;
   }
+  fesd__point_eval pe = {0};
+  pe.F = it->pscr.F;
+  if ((st = fesd__model_eval(m, x, u, &pe))) return st;
   memset(block, 0, (size_t)nx * sizeof(double));
-  for (int k = 0; k < m->nsys; k++)
-    for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) {
-      if (th[i] == 0.0) continue;
-      if ((st = m->user.field(k, i - m->th_off[k], x, u, it->gbuf + nth, m->user.user)) != 0) {
-        m->failed = "field";
-        return FESD_ERR_CALLBACK;
-      }
-      for (int r = 0; r < nx; r++) block[r] += th[i] * it->gbuf[nth + r];
-    }
+  for (int i = 0; i < nth; i++)
+    if (th[i] != 0.0) fesd__F_axpy(m, &pe, i, th[i], block);
   return FESD_OK;
 }
 

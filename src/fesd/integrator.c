@@ -40,11 +40,12 @@ void fesd_free(fesd_integrator **itp) {
   if (!itp || !*itp) return;
   fesd_integrator *it = *itp;
   fesd_ncp_free(&it->ncp);
+  fesd__point_free(&it->pscr);
   fesd__system_free(&it->sys);
   fesd__model_free(&it->model);
   double *bufs[] = {it->x, it->lam00, it->theta_prev, it->u_cur, it->z, it->zws, it->z0, it->zpred,
                     it->raw, it->jac, it->lb, it->ub, it->Sx, it->Su, it->draw, it->dz, it->Dtmp,
-                    it->Stmp, it->gbuf, it->blk, it->pt_t, it->pt_q, it->pt_l, it->rec_h, it->rec_t,
+                    it->Stmp, it->gbuf, it->blk, it->vtmp, it->pt_t, it->pt_q, it->pt_l, it->rec_h, it->rec_t,
                     it->rec_x, it->rec_th, it->rec_la, it->rec_mu, it->rec_v};
   for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); i++) free(bufs[i]);
   for (fesd__saved *b = &it->bk; b <= &it->bk_sub; b++) {
@@ -92,7 +93,7 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
     free(it);
     return st;
   }
-  if ((st = fesd__system_init(&it->sys, &it->model, &tab, settings->n_fe))) {
+  if ((st = fesd__system_init(&it->sys, &it->model, &tab, settings->n_fe, settings->sensitivities))) {
     fesd__model_free(&it->model);
     free(it);
     return st;
@@ -123,25 +124,29 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   it->jac = dalloc((size_t)S->nnz, &fail);
   it->lb = dalloc(n, &fail);
   it->ub = dalloc(n, &fail);
+  /* sensitivity storage is O(n_x^2): only when asked for */
+  const size_t sx = settings->sensitivities ? nx : 1;
   for (fesd__saved *b = &it->bk; b <= &it->bk_sub; b++) {
     b->x = dalloc(nx, &fail);
     b->lam = dalloc(nth, &fail);
     b->th = dalloc(nth, &fail);
     b->zws = dalloc(n, &fail);
-    b->Sx = dalloc(nx * nx, &fail);
-    b->Su = dalloc(nx * nu, &fail);
-    b->ldp = dalloc(nth * np, &fail);
+    b->Sx = dalloc(sx * sx, &fail);
+    b->Su = dalloc(sx * nu, &fail);
+    b->ldp = dalloc(settings->sensitivities ? nth * np : 1, &fail);
   }
-  it->Sx = dalloc(nx * nx, &fail);
-  it->Su = dalloc(nx * nu, &fail);
+  it->Sx = dalloc(sx * sx, &fail);
+  it->Su = dalloc(sx * nu, &fail);
   if (settings->sensitivities) {
     it->draw = dalloc((size_t)S->n_raw * np, &fail);
     it->dz = dalloc(n * np, &fail);
   }
-  it->Dtmp = dalloc((nx > nth ? nx : nth) * np, &fail);
-  it->Stmp = dalloc(nx * (nx > nu ? nx : nu), &fail);
+  it->Dtmp = dalloc(settings->sensitivities ? (nx > nth ? nx : nth) * np : 1, &fail);
+  it->Stmp = dalloc(settings->sensitivities ? nx * (nx > nu ? nx : nu) : 1, &fail);
   it->gbuf = dalloc(nth + nx, &fail);
   it->blk = dalloc((size_t)S->sb, &fail);
+  it->vtmp = dalloc(2 * nx, &fail);
+  if (fesd__point_alloc(&it->model, &it->pscr, 1)) fail = 1;
   it->pt_t = dalloc(N * (s + 1) + 1, &fail);
   it->pt_q = dalloc((N * (s + 1) + 1) * nth, &fail);
   it->pt_l = dalloc((N * (s + 1) + 1) * nth, &fail);
@@ -190,9 +195,11 @@ int fesd_set_state(fesd_integrator *it, double t0, const double *x0, const doubl
   memcpy(it->x, x0, (size_t)it->nx * sizeof(double));
   it->have_ws = 0;
   it->have_prev_theta = 0;
-  memset(it->Sx, 0, (size_t)it->nx * it->nx * sizeof(double));
-  for (int i = 0; i < it->nx; i++) it->Sx[i * it->nx + i] = 1.0;
-  if (it->nu > 0) memset(it->Su, 0, (size_t)it->nx * it->nu * sizeof(double));
+  if (it->set.sensitivities) {
+    memset(it->Sx, 0, (size_t)it->nx * it->nx * sizeof(double));
+    for (int i = 0; i < it->nx; i++) it->Sx[i * it->nx + i] = 1.0;
+    if (it->nu > 0) memset(it->Su, 0, (size_t)it->nx * it->nu * sizeof(double));
+  }
   memset(&it->stats, 0, sizeof(it->stats));
   it->sum_iter_ord = it->sum_iter_sw = 0;
   it->n_el = 0;
@@ -214,6 +221,7 @@ void fesd__save(fesd_integrator *it, fesd__saved *b) {
   memcpy(b->lam, it->lam00, nth * sizeof(double));
   memcpy(b->th, it->theta_prev, nth * sizeof(double));
   memcpy(b->zws, it->zws, (size_t)it->n * sizeof(double));
+  if (!it->set.sensitivities) return; /* O(n_x^2) state only then */
   memcpy(b->Sx, it->Sx, nx * nx * sizeof(double));
   memcpy(b->Su, it->Su, nx * nu * sizeof(double));
   memcpy(b->ldp, it->sys.lam00_dp, nth * (size_t)it->np * sizeof(double));
@@ -230,6 +238,7 @@ void fesd__load(fesd_integrator *it, const fesd__saved *b) {
   memcpy(it->lam00, b->lam, nth * sizeof(double));
   memcpy(it->theta_prev, b->th, nth * sizeof(double));
   memcpy(it->zws, b->zws, (size_t)it->n * sizeof(double));
+  if (!it->set.sensitivities) return;
   memcpy(it->Sx, b->Sx, nx * nx * sizeof(double));
   memcpy(it->Su, b->Su, nx * nu * sizeof(double));
   memcpy(it->sys.lam00_dp, b->ldp, nth * (size_t)it->np * sizeof(double));

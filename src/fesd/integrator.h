@@ -33,7 +33,8 @@ struct fesd_integrator {
   fesd__saved bk, bk_sub; /* step start, sub-step start */
   /* sensitivities */
   double *Sx, *Su, *draw, *dz, *Dtmp, *Stmp;
-  double *gbuf, *blk;
+  double *gbuf, *blk, *vtmp; /* vtmp: 2 nx */
+  fesd__point_eval pscr;     /* scratch model evaluation */
   double *pt_t, *pt_q, *pt_l; /* switch prediction: point times and q values */
   int *pt_src, *kb, *sw_at;
   /* active-set path */

@@ -1,7 +1,8 @@
-/* Internal: validated copy of a user model, sign matrices, and evaluation of
- * the stacked fields F (nx x n_theta), indicators g (n_theta) and their
- * Jacobians at one point, with central finite differences when the user gives
- * no Jacobian callback. */
+/* Internal: validated copy of a user model, sign matrices, and evaluation of the mode
+ * fields, the Stewart indicators g and their Jacobians at one point. Everything is kept
+ * in a sparse layout (a dense model is the special case rows = all, full patterns), so
+ * the cost of a step grows with the nonzeros of the model, not with n_x^2. Central finite
+ * differences replace missing Jacobian callbacks of dense models. */
 #ifndef FESD_MODEL_H
 #define FESD_MODEL_H
 
@@ -13,29 +14,55 @@ typedef struct {
   int *th_off;           /* first stacked mode of subsystem k (nsys + 1 entries) */
   int *sys_of;           /* subsystem of stacked mode i */
   signed char **S;       /* per subsystem nf x nc (NULL when nc == 0) */
-  int max_rows;          /* max over k of (nc_k or nf_k): rows of one switch callback */
-  fesd_model user;       /* callbacks and user pointer (array fields not used) */
+  int *swr;              /* rows of the switch callback of subsystem k (nc or nf) */
+  int sparse;            /* the user gave sparsity */
+  /* per subsystem: rows its fields touch; df/dx pattern (r indexes rows); switch pattern */
+  int *nr, **rows;
+  int *fj_nnz, **fj_r, **fj_c;
+  int *sj_nnz, **sj_r, **sj_c;
+  int *ncol, **cols, **sj_cp; /* distinct columns of the switch pattern; entry -> column */
+  /* offsets of stacked mode i / subsystem k in the point-evaluation arrays */
+  int *Foff, *dFoff, *Fuoff, *dgoff;
+  int nF, ndF, nFu, ndg;
+  /* union pattern of sum_i theta_i df_i/dx (column-major order), and entry maps */
+  int pf_nnz, *pf_r, *pf_c, **fj_map;
+  fesd_model user;       /* callbacks and user pointer */
   /* scratch */
+  int max_sw, max_fj, max_nr;
   double *xp, *cbuf, *cbuf2, *dcbuf, *dcubuf, *fbuf, *fbuf2, *up, *jxbuf;
   const char *failed;    /* name of the callback that failed last */
 } fesd__model;
 
-/* Output of one evaluation; NULL members are not computed. Column-major. */
+/* Output of one evaluation; NULL members are not computed. */
 typedef struct {
-  double *F;     /* nx x nth: column i = f_i */
+  double *F;     /* nF: the nr[k] values of mode i at Foff[i] */
   double *g;     /* nth */
-  double *dFdx;  /* nth blocks of nx x nx */
-  double *dgdx;  /* nth x nx */
-  double *dFdu;  /* nth blocks of nx x nu */
-  double *dgdu;  /* nth x nu */
+  double *dFdx;  /* ndF: the fj_nnz[k] values of mode i at dFoff[i] */
+  double *dgdx;  /* ndg: subsystem k's nf_k x ncol_k block (column-major) at dgoff[k] */
+  double *dFdu;  /* nFu: mode i's nr x nu block at Fuoff[i] */
+  double *dgdu;  /* nth x nu, column-major */
 } fesd__point_eval;
 
 int fesd__model_init(fesd__model *m, const fesd_model *user);
 void fesd__model_free(fesd__model *m);
+/* Allocate / free the arrays of a point evaluation for this model. */
+int fesd__point_alloc(const fesd__model *m, fesd__point_eval *pe, int fields);
+void fesd__point_free(fesd__point_eval *pe);
 /* Evaluate at x (u may be NULL when nu == 0). Returns FESD_OK, FESD_ERR_CALLBACK or
  * FESD_ERR_NONFINITE (m->failed names the callback). */
 int fesd__model_eval(fesd__model *m, const double *x, const double *u, fesd__point_eval *out);
 /* Only g at x. */
 int fesd__model_g(fesd__model *m, const double *x, const double *u, double *g);
+
+/* y += a f_i (y dense, nx) */
+void fesd__F_axpy(const fesd__model *m, const fesd__point_eval *pe, int i, double a, double *y);
+/* grad g_i . v (v dense, nx) */
+double fesd__dg_dot(const fesd__model *m, const fesd__point_eval *pe, int i, const double *v);
+/* y += a grad g_i (y dense, nx) */
+void fesd__dg_axpy(const fesd__model *m, const fesd__point_eval *pe, int i, double a, double *y);
+/* J = sum_i theta_i df_i/dx on the union pattern (pf_nnz values) */
+void fesd__Jth(const fesd__model *m, const fesd__point_eval *pe, const double *theta, double *J);
+/* y = J v for J on the union pattern (y dense, nx, overwritten) */
+void fesd__pf_mv(const fesd__model *m, const double *J, const double *v, double *y);
 
 #endif

@@ -184,16 +184,16 @@ static int active_solve(fesd_integrator *it, double *z, int max_iter, fesd__viol
  * to j (a crossing), < 0 that f_j pushes back to the surface (sliding). */
 static int crossing_first(fesd_integrator *it, const double *x, int i, int j, int *cross) {
   fesd__model *m = &it->model;
-  const int nx = m->nx, nth = m->nth;
   fesd__point_eval pe = {0};
-  pe.F = it->sys.pe[0].F;
-  pe.g = it->sys.pe[0].g;
-  pe.dgdx = it->sys.pe[0].dgdx;
+  pe.F = it->pscr.F;
+  pe.g = it->pscr.g;
+  pe.dgdx = it->pscr.dgdx;
   int st = fesd__model_eval(m, x, it->sys.u, &pe);
   if (st) return st;
-  double d = 0;
-  for (int r = 0; r < nx; r++) d += (pe.dgdx[r * nth + i] - pe.dgdx[r * nth + j]) * pe.F[j * nx + r];
-  *cross = d > 0;
+  double *f = it->vtmp;
+  memset(f, 0, (size_t)m->nx * sizeof(double));
+  fesd__F_axpy(m, &pe, j, 1.0, f);
+  *cross = fesd__dg_dot(m, &pe, i, f) - fesd__dg_dot(m, &pe, j, f) > 0;
   return FESD_OK;
 }
 

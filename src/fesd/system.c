@@ -7,14 +7,7 @@ void fesd__system_free(fesd__system *S) {
   if (!S) return;
   if (S->pe) {
     int np = S->N * S->s + S->N;
-    for (int p = 0; p < np; p++) {
-      free(S->pe[p].F);
-      free(S->pe[p].g);
-      free(S->pe[p].dFdx);
-      free(S->pe[p].dgdx);
-      free(S->pe[p].dFdu);
-      free(S->pe[p].dgdu);
-    }
+    for (int p = 0; p < np; p++) fesd__point_free(&S->pe[p]);
   }
   free(S->pe);
   free(S->el);
@@ -28,6 +21,8 @@ void fesd__system_free(fesd__system *S) {
   free(S->pcol);
   free(S->X);
   free(S->Jth);
+  free(S->JK);
+  free(S->KG);
   free(S->Juth);
   free(S->lam00_dp);
   free(S->tmp);
@@ -66,80 +61,69 @@ double fesd__cross_value(const fesd__system *S, const double *z, int n) {
   return c;
 }
 
-/* ---- Jacobian emission: one traversal writes either the pattern or the values,
- *      so both always agree. ---- */
+/* ---- Jacobian emission: one traversal counts the entries, writes the pattern, or writes
+ *      the values, so all three always agree. ---- */
 typedef struct {
-  int k, pattern;
+  int k, pattern; /* pattern: 1 = write (row, col); 0 = write values (val) or count (val NULL) */
   int *row, *col;
   double *val;
 } emitter;
 
-#define EMIT(E, r, c, expr)    \
-  do {                         \
-    if ((E)->pattern) {        \
-      (E)->row[(E)->k] = (r);  \
-      (E)->col[(E)->k] = (c);  \
-    } else {                   \
-      (E)->val[(E)->k] = (expr); \
-    }                          \
-    (E)->k++;                  \
+#define EMIT(E, r, c, expr)        \
+  do {                             \
+    if ((E)->pattern) {            \
+      (E)->row[(E)->k] = (r);      \
+      (E)->col[(E)->k] = (c);      \
+    } else if ((E)->val) {         \
+      (E)->val[(E)->k] = (expr);   \
+    }                              \
+    (E)->k++;                      \
   } while (0)
 
-/* Stage-point scratch: p = n*s + j for stages, N*s + n for boundary points. */
+/* Entries of the indicator Jacobian block of every subsystem: (row, state column, value). */
+#define EMIT_DG(E, rowbase, colbase, blkptr, scale)                                  \
+  for (int kk = 0; kk < m->nsys; kk++) {                                            \
+    const int nfk = m->nf[kk], off = m->th_off[kk];                                 \
+    for (int cp = 0; cp < m->ncol[kk]; cp++)                                        \
+      for (int li = 0; li < nfk; li++)                                              \
+        EMIT(E, (rowbase) + off + li, (colbase) + m->cols[kk][cp],                  \
+             (scale) * (blkptr)[m->dgoff[kk] + (size_t)cp * nfk + li]);             \
+  }
+
 static void emit_jacobian(const fesd__system *S, const double *z, emitter *E) {
   const int N = S->N, s = S->s, nx = S->nx, nth = S->nth, nsys = S->nsys;
   const fesd__model *m = S->model;
+  const int values = !E->pattern && E->val;
   for (int n = 0; n < N; n++) {
-    const double h = E->pattern ? 0 : z[S->ho[n]];
+    const double h = values ? z[S->ho[n]] : 0;
     for (int j = 0; j < s; j++) {
       const int p = n * s + j;
       const fesd__point_eval *pe = &S->pe[p];
-      const double *Jth = S->Jth + (size_t)p * nx * nx;
+      const double *J = S->Jth + (size_t)p * m->pf_nnz, *JK = S->JK + (size_t)p * nx;
       const int rV = S->rel[n] + j * S->rs, rG = rV + nx, rS = rG + nth;
-      const double *X = S->X + (size_t)p * nx;
-      /* V rows: v_j - F(X) theta_j */
+      /* V rows: v_j - F(X_j) theta_j, X_j = x_n + h sum_l a_jl v_l */
       for (int l = 0; l < s; l++) {
         const double a = S->tab.A[j][l];
-        for (int c = 0; c < nx; c++)
-          for (int r = 0; r < nx; r++)
-            EMIT(E, rV + r, fesd__v(S, n, l) + c, (j == l && r == c ? 1.0 : 0.0) - h * a * Jth[c * nx + r]);
+        if (j == l)
+          for (int r = 0; r < nx; r++) EMIT(E, rV + r, fesd__v(S, n, l) + r, 1.0);
+        for (int q = 0; q < m->pf_nnz; q++) EMIT(E, rV + m->pf_r[q], fesd__v(S, n, l) + m->pf_c[q], -h * a * J[q]);
       }
       if (n > 0)
-        for (int c = 0; c < nx; c++)
-          for (int r = 0; r < nx; r++) EMIT(E, rV + r, S->xo[n - 1] + c, -Jth[c * nx + r]);
-      /* d/dh: X = x_n + h * K_j with K_j = (X - x_n)/h; use sum_l a_jl v_l directly. */
-      for (int r = 0; r < nx; r++) {
-        double val = 0;
-        if (!E->pattern) {
-          for (int c = 0; c < nx; c++) {
-            double kc = 0;
-            for (int l = 0; l < s; l++) kc += S->tab.A[j][l] * z[fesd__v(S, n, l) + c];
-            val -= Jth[c * nx + r] * kc;
-          }
-        }
-        EMIT(E, rV + r, S->ho[n], val);
+        for (int q = 0; q < m->pf_nnz; q++) EMIT(E, rV + m->pf_r[q], S->xo[n - 1] + m->pf_c[q], -J[q]);
+      for (int r = 0; r < nx; r++) EMIT(E, rV + r, S->ho[n], -JK[r]); /* d/dh: -J K_j */
+      for (int i = 0; i < nth; i++) {
+        const int k = m->sys_of[i];
+        for (int r = 0; r < m->nr[k]; r++)
+          EMIT(E, rV + m->rows[k][r], fesd__th(S, n, j) + i, -pe->F[m->Foff[i] + r]);
       }
-      for (int i = 0; i < nth; i++)
-        for (int r = 0; r < nx; r++) EMIT(E, rV + r, fesd__th(S, n, j) + i, -pe->F[i * nx + r]);
-      (void)X;
       /* G rows: g(X) - lambda - mu e */
       for (int l = 0; l < s; l++) {
         const double a = S->tab.A[j][l];
-        for (int c = 0; c < nx; c++)
-          for (int i = 0; i < nth; i++) EMIT(E, rG + i, fesd__v(S, n, l) + c, h * a * pe->dgdx[c * nth + i]);
+        EMIT_DG(E, rG, fesd__v(S, n, l), pe->dgdx, h * a);
       }
-      if (n > 0)
-        for (int c = 0; c < nx; c++)
-          for (int i = 0; i < nth; i++) EMIT(E, rG + i, S->xo[n - 1] + c, pe->dgdx[c * nth + i]);
+      if (n > 0) EMIT_DG(E, rG, S->xo[n - 1], pe->dgdx, 1.0);
       for (int i = 0; i < nth; i++) {
-        double val = 0;
-        if (!E->pattern)
-          for (int c = 0; c < nx; c++) {
-            double kc = 0;
-            for (int l = 0; l < s; l++) kc += S->tab.A[j][l] * z[fesd__v(S, n, l) + c];
-            val += pe->dgdx[c * nth + i] * kc;
-          }
-        EMIT(E, rG + i, S->ho[n], val);
+        EMIT(E, rG + i, S->ho[n], S->KG[(size_t)p * nth + i]); /* d/dh: grad g_i . K_j */
         EMIT(E, rG + i, fesd__la(S, n, j) + i, -1.0);
         EMIT(E, rG + i, fesd__mu(S, n, j) + m->sys_of[i], -1.0);
       }
@@ -149,15 +133,14 @@ static void emit_jacobian(const fesd__system *S, const double *z, emitter *E) {
     if (S->lbo[n] >= 0) {
       const fesd__point_eval *pb = &S->pe[N * s + n];
       const int rL = S->rlb[n], rM = rL + nth, lb = S->lbo[n];
-      for (int c = 0; c < nx; c++)
-        for (int i = 0; i < nth; i++) EMIT(E, rL + i, S->xo[n] + c, pb->dgdx[c * nth + i]);
+      EMIT_DG(E, rL, S->xo[n], pb->dgdx, 1.0);
       for (int i = 0; i < nth; i++) {
         EMIT(E, rL + i, lb + i, -1.0);
         EMIT(E, rL + i, lb + nth + m->sys_of[i], -1.0);
       }
       for (int i = 0; i < nth; i++) {
-        EMIT(E, rM + m->sys_of[i], fesd__th(S, n, s - 1) + i, z ? z[lb + i] : 0.0);
-        EMIT(E, rM + m->sys_of[i], lb + i, z ? z[fesd__th(S, n, s - 1) + i] : 0.0);
+        EMIT(E, rM + m->sys_of[i], fesd__th(S, n, s - 1) + i, z[lb + i]);
+        EMIT(E, rM + m->sys_of[i], lb + i, z[fesd__th(S, n, s - 1) + i]);
       }
     }
     /* X rows: x_{n+1} - x_n - h sum b_j v_j */
@@ -166,7 +149,7 @@ static void emit_jacobian(const fesd__system *S, const double *z, emitter *E) {
       EMIT(E, rX + r, S->xo[n] + r, 1.0);
       if (n > 0) EMIT(E, rX + r, S->xo[n - 1] + r, -1.0);
       double val = 0;
-      if (!E->pattern)
+      if (values)
         for (int j = 0; j < s; j++) val -= S->tab.b[j] * z[fesd__v(S, n, j) + r];
       EMIT(E, rX + r, S->ho[n], val);
       for (int j = 0; j < s; j++) EMIT(E, rX + r, fesd__v(S, n, j) + r, -h * S->tab.b[j]);
@@ -179,11 +162,11 @@ static void emit_jacobian(const fesd__system *S, const double *z, emitter *E) {
     EMIT(E, fesd__rowH(S, k), S->ho[k - 1], -1.0);
     const int rC = fesd__rowC(S, k);
     for (int n = k - 1; n <= k; n++) {
-      const double *L = E->pattern ? NULL : fesd__left_lambda(S, z, n);
-      const double *R = (S->bp && S->lbo[n] >= 0 && !E->pattern) ? z + S->lbo[n] : NULL;
+      const double *L = values ? fesd__left_lambda(S, z, n) : NULL;
+      const double *R = (S->bp && S->lbo[n] >= 0 && values) ? z + S->lbo[n] : NULL;
       for (int i = 0; i < nth; i++) {
         double Th = 0, Lt = 0;
-        if (!E->pattern) {
+        if (values) {
           Lt = L[i] + (R ? R[i] : 0);
           for (int j = 0; j < s; j++) {
             Th += z[fesd__th(S, n, j) + i];
@@ -213,7 +196,7 @@ static void emit_jacobian(const fesd__system *S, const double *z, emitter *E) {
       }
 }
 
-int fesd__system_init(fesd__system *S, fesd__model *m, const fesd_tableau *tab, int N) {
+int fesd__system_init(fesd__system *S, fesd__model *m, const fesd_tableau *tab, int N, int sens) {
   memset(S, 0, sizeof(*S));
   S->model = m;
   S->tab = *tab;
@@ -264,56 +247,28 @@ int fesd__system_init(fesd__system *S, fesd__model *m, const fesd_tableau *tab, 
   S->n_pair = N * s * nth;
   S->n_raw = S->n_eq + 2 * S->n_pair;
   int np = N * s + N;
+  size_t nu1 = (size_t)(nu > 0 ? nu : 1), pf = (size_t)(m->pf_nnz > 0 ? m->pf_nnz : 1);
   S->pe = calloc((size_t)np, sizeof(*S->pe));
   S->X = malloc((size_t)np * nx * sizeof(double));
-  S->Jth = malloc((size_t)N * s * nx * nx * sizeof(double));
-  S->Juth = malloc((size_t)N * s * nx * (nu > 0 ? nu : 1) * sizeof(double));
-  S->lam00_dp = malloc((size_t)nth * (nx + nu) * sizeof(double));
-  S->tmp = malloc((size_t)(nx + nth) * sizeof(double));
-  if (!S->pe || !S->X || !S->Jth || !S->Juth || !S->lam00_dp || !S->tmp) goto nomem;
-  for (int p = 0; p < np; p++) {
-    fesd__point_eval *pe = &S->pe[p];
-    int stage = p < N * s;
-    pe->g = malloc((size_t)nth * sizeof(double));
-    pe->dgdx = malloc((size_t)nth * nx * sizeof(double));
-    pe->dgdu = malloc((size_t)nth * (nu > 0 ? nu : 1) * sizeof(double));
-    if (!pe->g || !pe->dgdx || !pe->dgdu) goto nomem;
-    if (stage) {
-      pe->F = malloc((size_t)nx * nth * sizeof(double));
-      pe->dFdx = malloc((size_t)nth * nx * nx * sizeof(double));
-      pe->dFdu = malloc((size_t)nth * nx * (nu > 0 ? nu : 1) * sizeof(double));
-      if (!pe->F || !pe->dFdx || !pe->dFdu) goto nomem;
-    }
-  }
+  S->Jth = malloc((size_t)N * s * pf * sizeof(double));
+  S->JK = malloc((size_t)N * s * nx * sizeof(double));
+  S->KG = malloc((size_t)N * s * nth * sizeof(double));
+  S->Juth = malloc((size_t)N * s * nx * nu1 * sizeof(double));
+  S->lam00_dp = malloc((sens ? (size_t)nth * (nx + nu) : 1) * sizeof(double)); /* O(n^2) */
+  S->tmp = malloc((size_t)(2 * nx + nth) * sizeof(double));
+  if (!S->pe || !S->X || !S->Jth || !S->JK || !S->KG || !S->Juth || !S->lam00_dp || !S->tmp)
+    goto nomem;
+  for (int p = 0; p < np; p++)
+    if (fesd__point_alloc(m, &S->pe[p], p < N * s)) goto nomem;
   /* pattern: count, then record */
-  emitter E = {0, 1, NULL, NULL, NULL};
-  {
-    /* counting pass: pattern mode with throwaway arrays sized by a first dry count */
-    int cnt = 0;
-    for (int n = 0; n < N; n++) {
-      cnt += s * (s * nx * nx + (n > 0) * nx * nx + nx + nth * nx); /* V rows */
-      cnt += s * (s * nx * nth + (n > 0) * nx * nth + 3 * nth);      /* G rows */
-      cnt += s * nth;                                                  /* S rows */
-      if (S->lbo[n] >= 0) cnt += nx * nth + 2 * nth + 2 * nth;
-      cnt += nx * (2 + (n > 0) + s);
-    }
-    for (int k = 1; k < N; k++) {
-      cnt += 2;
-      for (int n = k - 1; n <= k; n++) cnt += nth * (2 * s + (n > 0) + (S->bp && S->lbo[n] >= 0));
-    }
-    cnt += N + 2 * S->n_pair;
-    S->nnz = cnt;
-  }
+  emitter E = {0, 0, NULL, NULL, NULL};
+  emit_jacobian(S, NULL, &E);
+  S->nnz = E.k;
   S->prow = malloc((size_t)S->nnz * sizeof(int));
   S->pcol = malloc((size_t)S->nnz * sizeof(int));
   if (!S->prow || !S->pcol) goto nomem;
-  E.row = S->prow;
-  E.col = S->pcol;
+  E = (emitter){0, 1, S->prow, S->pcol, NULL};
   emit_jacobian(S, NULL, &E);
-  if (E.k != S->nnz) { /* internal consistency: the count formula must match */
-    fesd__system_free(S);
-    return FESD_ERR_PATTERN;
-  }
   return FESD_OK;
 nomem:
   fesd__system_free(S);
@@ -324,6 +279,7 @@ nomem:
 static int eval_points(fesd__system *S, const double *z, int want_jac) {
   const int N = S->N, s = S->s, nx = S->nx, nth = S->nth, nu = S->nu;
   fesd__model *m = S->model;
+  double *K = S->tmp; /* K_j = sum_l a_jl v_l */
   for (int n = 0; n < N; n++) {
     const double *xn = elem_start(S, z, n);
     const double h = z[S->ho[n]];
@@ -333,6 +289,7 @@ static int eval_points(fesd__system *S, const double *z, int want_jac) {
       for (int r = 0; r < nx; r++) {
         double acc = 0;
         for (int l = 0; l < s; l++) acc += S->tab.A[j][l] * z[fesd__v(S, n, l) + r];
+        K[r] = acc;
         X[r] = xn[r] + h * acc;
       }
       fesd__point_eval pe = S->pe[p];
@@ -342,19 +299,19 @@ static int eval_points(fesd__system *S, const double *z, int want_jac) {
       if (st) return st;
       if (want_jac) {
         const double *th = z + fesd__th(S, n, j);
-        double *J = S->Jth + (size_t)p * nx * nx;
-        memset(J, 0, (size_t)nx * nx * sizeof(double));
-        for (int i = 0; i < nth; i++) {
-          if (th[i] == 0.0) continue;
-          const double *d = pe.dFdx + (size_t)i * nx * nx;
-          for (int q = 0; q < nx * nx; q++) J[q] += th[i] * d[q];
-        }
+        double *J = S->Jth + (size_t)p * m->pf_nnz;
+        fesd__Jth(m, &pe, th, J);
+        fesd__pf_mv(m, J, K, S->JK + (size_t)p * nx);
+        for (int i = 0; i < nth; i++) S->KG[(size_t)p * nth + i] = fesd__dg_dot(m, &pe, i, K);
         if (S->want_u && nu > 0) {
           double *Ju = S->Juth + (size_t)p * nx * nu;
           memset(Ju, 0, (size_t)nx * nu * sizeof(double));
           for (int i = 0; i < nth; i++) {
-            const double *d = pe.dFdu + (size_t)i * nx * nu;
-            for (int q = 0; q < nx * nu; q++) Ju[q] += th[i] * d[q];
+            if (th[i] == 0.0) continue;
+            const int k = m->sys_of[i];
+            const double *d = pe.dFdu + m->Fuoff[i];
+            for (int c = 0; c < nu; c++)
+              for (int r = 0; r < m->nr[k]; r++) Ju[c * nx + m->rows[k][r]] += th[i] * d[c * m->nr[k] + r];
           }
         }
       }
@@ -387,11 +344,9 @@ int fesd__system_eval(const double *z, double *raw, double *jac, void *ctx) {
       const int rV = S->rel[n] + j * S->rs, rG = rV + nx, rS = rG + nth;
       const double *v = z + fesd__v(S, n, j), *th = z + fesd__th(S, n, j);
       const double *la = z + fesd__la(S, n, j), *mu = z + fesd__mu(S, n, j);
-      for (int r = 0; r < nx; r++) {
-        double acc = v[r];
-        for (int i = 0; i < nth; i++) acc -= pe->F[i * nx + r] * th[i];
-        raw[rV + r] = acc;
-      }
+      for (int r = 0; r < nx; r++) raw[rV + r] = v[r];
+      for (int i = 0; i < nth; i++)
+        if (th[i] != 0.0) fesd__F_axpy(m, pe, i, -th[i], raw + rV);
       for (int i = 0; i < nth; i++) raw[rG + i] = pe->g[i] - la[i] - mu[m->sys_of[i]];
       for (int k = 0; k < nsys; k++) raw[rS + k] = 1.0;
       for (int i = 0; i < nth; i++) raw[rS + m->sys_of[i]] -= th[i];
@@ -434,18 +389,20 @@ int fesd__system_eval(const double *z, double *raw, double *jac, void *ctx) {
 
 int fesd__system_param_jac(fesd__system *S, const double *z, double *out) {
   const int N = S->N, s = S->s, nx = S->nx, nth = S->nth, nu = S->nu, np = nx + nu;
-  const int ld = S->n_raw;
-  memset(out, 0, (size_t)ld * np * sizeof(double));
+  const fesd__model *m = S->model;
+  const size_t ld = (size_t)S->n_raw;
+  memset(out, 0, ld * np * sizeof(double));
   /* element 0 depends on x_start explicitly */
   for (int j = 0; j < s; j++) {
-    const int p = j;
-    const double *Jth = S->Jth + (size_t)p * nx * nx;
-    const fesd__point_eval *pe = &S->pe[p];
+    const double *J = S->Jth + (size_t)j * m->pf_nnz;
+    const fesd__point_eval *pe = &S->pe[j];
     const int rV = S->rel[0] + j * S->rs, rG = rV + nx;
-    for (int c = 0; c < nx; c++) {
-      for (int r = 0; r < nx; r++) out[(size_t)c * ld + rV + r] = -Jth[c * nx + r];
-      for (int i = 0; i < nth; i++) out[(size_t)c * ld + rG + i] = pe->dgdx[c * nth + i];
-    }
+    for (int q = 0; q < m->pf_nnz; q++) out[(size_t)m->pf_c[q] * ld + rV + m->pf_r[q]] -= J[q];
+    for (int k = 0; k < m->nsys; k++)
+      for (int cp = 0; cp < m->ncol[k]; cp++)
+        for (int li = 0; li < m->nf[k]; li++)
+          out[(size_t)m->cols[k][cp] * ld + rG + m->th_off[k] + li] +=
+              pe->dgdx[m->dgoff[k] + (size_t)cp * m->nf[k] + li];
   }
   for (int r = 0; r < nx; r++) out[(size_t)r * ld + S->rx[0] + r] = -1.0;
   /* u: every stage point and boundary point */

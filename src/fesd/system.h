@@ -45,14 +45,17 @@ typedef struct {
   /* scratch: evaluations at N*s stage points and N boundary points */
   fesd__point_eval *pe;
   double *X;    /* stage states, (N*s + N) x nx */
-  double *Jth;  /* sum_i theta_i dF_i/dx per stage point, N*s blocks nx x nx */
+  double *Jth;  /* sum_i theta_i df_i/dx per stage point on the model's union pattern */
+  double *JK;   /* Jth K_j per stage point (nx), K_j = sum_l a_jl v_l: the h column */
+  double *KG;   /* grad g_i . K_j per stage point (nth) */
   double *Juth; /* sum_i theta_i dF_i/du per stage point, N*s blocks nx x nu */
   double *lam00_dp; /* d lambda00 / d(x_start, u): nth x (nx + nu) */
-  double *tmp;  /* nx + nth */
+  double *tmp;  /* 2 nx + nth */
   int status;   /* last model status */
 } fesd__system;
 
-int fesd__system_init(fesd__system *S, fesd__model *m, const fesd_tableau *tab, int N);
+/* sens: allocate the parameter-derivative storage of sensitivities (O(nth (nx + nu))) */
+int fesd__system_init(fesd__system *S, fesd__model *m, const fesd_tableau *tab, int N, int sens);
 void fesd__system_free(fesd__system *S);
 
 /* Offsets. */

@@ -260,7 +260,7 @@ const char *const *fesd_problem_names(void) { return names; }
 
 static void scalar_problem(fesd_problem *p, const scalar_law *law, double x0, double T) {
   p->model = (fesd_model){2, 0, 1, one_sys_two_modes, one_switch, NULL, scalar_field,
-                          scalar_field_jac, scalar_sw, scalar_sw_jac, (void *)law};
+                          scalar_field_jac, scalar_sw, scalar_sw_jac, (void *)law, NULL};
   p->x0[0] = x0;
   p->x0[1] = 0;
   p->T = T;
@@ -274,7 +274,7 @@ int fesd_problem_get(const char *name, fesd_problem *p) {
     p->name = "oscillator";
     p->description = "x' = A1 x outside / A2 x inside the unit circle; crossing at t = 1";
     p->model = (fesd_model){2, 0, 1, one_sys_two_modes, one_switch, NULL, osc_field, osc_field_jac,
-                            osc_sw, osc_sw_jac, NULL};
+                            osc_sw, osc_sw_jac, NULL, NULL};
     p->x0[0] = exp(-1.0);
     p->T = PI / 2;
     p->t_switch = 1.0;
@@ -309,7 +309,7 @@ int fesd_problem_get(const char *name, fesd_problem *p) {
     p->name = "ocp-dynamics";
     p->description = "q' = -sign(c(q)) + v, v' = u = 0: sliding on c1 = 0, then on c = 0";
     p->model = (fesd_model){4, 2, 2, two_sys_modes, two_sys_switch, NULL, ocp_field, ocp_field_jac,
-                            ocp_sw, ocp_sw_jac, NULL};
+                            ocp_sw, ocp_sw_jac, NULL, NULL};
     p->x0[0] = 2 * PI / 3;
     p->x0[1] = PI / 3;
     p->T = 4.0;
@@ -319,7 +319,7 @@ int fesd_problem_get(const char *name, fesd_problem *p) {
     p->name = "stewart-anitescu";
     p->description = "x' in 2 - sign(x), q' = x^2 (running cost), x0 = (-1, 0), T = 2";
     p->model = (fesd_model){2, 0, 1, one_sys_two_modes, one_switch, NULL, sa_field, sa_field_jac,
-                            scalar_sw, scalar_sw_jac, NULL};
+                            scalar_sw, scalar_sw_jac, NULL, NULL};
     p->x0[0] = -1.0;
     p->T = 2.0;
     p->t_switch = 1.0 / 3;
@@ -327,7 +327,7 @@ int fesd_problem_get(const char *name, fesd_problem *p) {
     p->name = "slide-exit-2d";
     p->description = "slides on c = x1 + x2^2/2 from x0 = 0, leaves it at t = 1.02617735";
     p->model = (fesd_model){2, 0, 1, one_sys_two_modes, one_switch, NULL, se_field, se_field_jac,
-                            se_sw, se_sw_jac, NULL};
+                            se_sw, se_sw_jac, NULL, NULL};
     p->T = 2.1;
     double x2;
     fesd_problem_slide_exit_point(&p->t_switch, &x2);

@@ -24,7 +24,7 @@ static int check(const char *prob, fesd_rk_family fam, int s, int N) {
   fesd__system S;
   fesd_tableau tab;
   if (fesd__model_init(&M, &P.model) || fesd_tableau_get(fam, s, &tab) ||
-      fesd__system_init(&S, &M, &tab, N)) {
+      fesd__system_init(&S, &M, &tab, N, 1)) {
     printf("FAIL setup %s\n", prob);
     return 1;
   }
