@@ -139,7 +139,7 @@ typedef struct {
   double cc_max;        /**< max cross-complementarity product of the accepted solution */
   double time;          /**< wall-clock seconds of the step */
   const char *failed_callback; /**< on FESD_ERR_CALLBACK/NONFINITE: "field", "switch", ... */
-  double failed_time;   /**< on failure: start time of the failed step */
+  double failed_time;   /**< on failure: start time of the sub-step that failed */
 } fesd_step_info;
 
 typedef struct fesd_integrator fesd_integrator; /**< opaque */
