@@ -107,6 +107,9 @@ typedef struct {
                                  default 1; 0 = the paper's formulation */
   int max_splits;           /**< recursive halvings of a failed step (default 6, at most 12) */
   int sensitivities;        /**< propagate dx/dx0 and dx/du (default 0) */
+  int max_sweeps;           /**< fixed-point sweeps that make the initial guess of a step
+                                 consistent (default 8, at least 1; they stop early when
+                                 converged or slow, and cost no Jacobian) */
   fesd_ncp_settings ncp;    /**< linear algebra/line-search settings of the solver */
 } fesd_settings;
 

@@ -1,6 +1,6 @@
 # Plots of the bench CSVs (tools/bench.sh): gnuplot -e "dir='bench/results'" tools/plot.gp
-# writes order.png, pareto.png, sliding_exit.png, sensitivity.png, stewart_anitescu.png and
-# anatomy.png next to the CSVs. Curves are selected from the long-format CSVs by filters
+# writes order.png, pareto.png, sliding_exit.png, sensitivity.png, stewart_anitescu.png,
+# anatomy.png and growth.png next to the CSVs. Curves are selected from the long-format CSVs by filters
 # that return NaN for the other rows (each curve's rows are contiguous, so lines do not break).
 if (!exists("dir")) dir = "bench/results"
 set datafile separator ","
@@ -128,3 +128,19 @@ plot f using "share_eval":xtic(lab(0)) lc rgb word(cols,1) title "residual + Jac
      '' using "share_solver_other" lc rgb word(cols,3) title "rest of the solver", \
      '' using "share_set_rows" lc rgb word(cols,4) title "row selection", \
      '' using "share_outside" lc rgb word(cols,5) title "integrator outside the solver"
+
+# ---- 7. growth with the problem size (friction chain, sparse model API) ----
+f = dir."/growth.csv"
+set output dir."/growth.png"
+set terminal pngcairo size 800,600 font ",10"
+unset multiplot
+set logscale xy
+set format x "%g"
+set format y "10^{%L}"
+set key top left
+set title "Friction chain: CPU time per step against n (growth.csv)"
+set xlabel "n (masses = switching subsystems; n_x = 2n)"
+set ylabel "ms per step"
+plot f using (sel("series","default") ? column("n") : NaN):"ms_per_step" with linespoints lc rgb word(cols,1) pt 7 title "default (converged guess, few Newton iterations)", \
+     f using (sel("series","newton") ? column("n") : NaN):"ms_per_step" with linespoints lc rgb word(cols,2) pt 5 title "one Newton iteration (KLU) every step", \
+     f using (sel("series","default") ? column("n") : NaN):(0.0065 * column("n")) with lines lc black dt 2 title "linear"

@@ -94,7 +94,7 @@ int fesd__act_start(fesd_integrator *it, const double *u, unsigned char *a) {
   return tied ? resolve_ties(it, u, a) : FESD_OK;
 }
 
-/* theta restricted to the active set of each element, renormalised per subsystem; a
+/* theta restricted to the active set of each stage (act: N*s blocks of nth flags), renormalised per subsystem; a
  * subsystem where some active mode has (almost) no weight in the guess (a newly active
  * mode, e.g. a sliding candidate) starts from uniform weights, which keeps the
  * cross-complementarity row of that mode non-degenerate. */
@@ -102,8 +102,8 @@ void fesd__impose_active(fesd_integrator *it, double *z, const unsigned char *ac
   fesd__system *S = &it->sys;
   const fesd__model *m = &it->model;
   for (int n = 0; n < S->N; n++) {
-    const unsigned char *a = act + (size_t)n * S->nth;
     for (int j = 0; j < S->s; j++) {
+      const unsigned char *a = act + (size_t)(n * S->s + j) * S->nth;
       double *th = z + fesd__th(S, n, j);
       for (int k = 0; k < m->nsys; k++) {
         double sum = 0, low = INFINITY;
@@ -126,7 +126,7 @@ void fesd__impose_active(fesd_integrator *it, double *z, const unsigned char *ac
   }
 }
 
-/* Rows for fixed active sets: pairs A (theta = 0) or B (lambda = 0) per element;
+/* Rows for fixed active sets: pairs A (theta = 0) or B (lambda = 0) per stage;
  * boundary k: bmode[k] = 0 -> h_k = h_{k-1}; 1 -> cross-complementarity row;
  * 2 -> sliding exit of mode exit_mode[k]: the pair of its last stage before the boundary
  * is pinned (theta = lambda = 0) and neither boundary row is used. */
@@ -143,23 +143,25 @@ int fesd__rows_active(fesd_integrator *it, const unsigned char *act, const int *
     for (int j = 0; j < S->s; j++)
       for (int i = 0; i < S->nth; i++)
         it->pair_mode[fesd__pair(S, n, j, i)] =
-            act[(size_t)n * S->nth + i] ? FESD_NCP_PAIR_B : FESD_NCP_PAIR_A;
+            act[(size_t)(n * S->s + j) * S->nth + i] ? FESD_NCP_PAIR_B : FESD_NCP_PAIR_A;
   for (int k = 1; k < S->N; k++)
     if (bmode && bmode[k] == 2) it->pair_mode[fesd__pair(S, k - 1, S->s - 1, exit_mode[k])] = FESD_NCP_PAIR_PIN;
   return fesd_ncp_set_rows(it->ncp, it->eq_active, it->pair_mode);
 }
 
 /* Earliest sign violation of the fixed active sets in z, scanning the step start and the
- * stage (and boundary LP) points in time order. */
+ * stage (and boundary LP) points in time order. strict (the standard method, whose
+ * equations hold at every stage): every stage is checked. */
 int fesd__find_violation(fesd_integrator *it, const double *z, const unsigned char *act,
-                         fesd__violation *v) {
+                         int strict, fesd__violation *v) {
   fesd__system *S = &it->sys;
-  const int nth = S->nth;
+  const int nth = S->nth, s = S->s;
   const double tol = it->set.cc_tol;
   v->found = 0;
   v->t = INFINITY;
   for (int i = 0; i < nth; i++) {
     double t0 = 0, v0 = NAN; /* last point value of the monitored quantity */
+    int aprev = act[i];
     if (act[i])
       v0 = it->have_prev_theta ? it->theta_prev[i] : 1.0;
     else
@@ -167,17 +169,18 @@ int fesd__find_violation(fesd_integrator *it, const double *z, const unsigned ch
     double tn = 0;
     int done = 0;
     for (int n = 0; n < S->N && !done; n++) {
-      const int a = act[(size_t)n * nth + i];
-      if (n > 0 && a != act[(size_t)(n - 1) * nth + i]) v0 = NAN; /* switch at this boundary */
       double h = z[S->ho[n]];
-      for (int j = 0; j <= S->s; j++) {
+      for (int j = 0; j <= s; j++) {
         double t, val;
-        if (j < S->s) {
+        const int a = act[(size_t)(n * s + (j < s ? j : s - 1)) * nth + i];
+        if (a != aprev) v0 = NAN; /* the active set changes here: no interpolation across */
+        aprev = a;
+        if (j < s) {
           /* Stage states at c_j = 0 (Lobatto, explicit RK) lie O(h^2) off the element start,
            * and explicit stages are low-order predictions that can overshoot a surface the
-           * trajectory does not reach: their indicator signs are not switches. Explicit
-           * methods are checked at the element ends (boundary LP points) instead. */
-          if (S->tab.c[j] == 0.0 || (S->tab.is_explicit && !a)) continue;
+           * trajectory does not reach: for FESD their indicator signs are not switches
+           * (explicit methods are checked at the element ends). */
+          if (!strict && (S->tab.c[j] == 0.0 || (S->tab.is_explicit && !a))) continue;
           t = tn + S->tab.c[j] * h;
           val = a ? z[fesd__th(S, n, j) + i] : z[fesd__la(S, n, j) + i];
         } else {
@@ -194,6 +197,7 @@ int fesd__find_violation(fesd_integrator *it, const double *z, const unsigned ch
             v->sys = it->model.sys_of[i];
             v->enter = !a;
             v->element = n;
+            v->stage = n * s + (j < s ? j : s); /* j == s: the element-end LP point */
           }
           done = 1;
           break;

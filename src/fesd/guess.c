@@ -23,13 +23,13 @@ int fesd__consistent_guess(fesd_integrator *it, double *z) {
     const double *xn = n == 0 ? S->x0 : z + S->xo[n - 1];
     double h = z[S->ho[n]];
     /* The sweeps contract like (h |A| |dF/dx|)^k. They cost no Jacobian and no factorization,
-     * so up to 8 are spent while they contract fast (ratio <= 1/4): a converged guess saves
+     * so up to settings.max_sweeps (8) are spent while they contract fast (ratio <= 1/4): a converged guess saves
      * the Newton iteration of an ordinary step (measured: oscillator, Radau s = 3, N_sim = 40:
      * 40 iterations with 3 sweeps, 2 with converged sweeps). Slow contraction stops them
      * (Newton is then cheaper). A stiff mode makes them diverge (the guess overflows and
      * Newton fails), so when a sweep changes v clearly more than the previous one, the
      * stages are frozen at x_n for a last sweep: v_j = F(x_n) theta_j. */
-    const int n_sweep = S->tab.is_explicit ? s : 8;
+    const int n_sweep = S->tab.is_explicit ? s : it->set.max_sweeps;
     int frozen = 0;
     double prev = INFINITY, vmax = 0;
     for (int sweep = 0; sweep < n_sweep; sweep++) {

@@ -22,6 +22,7 @@ int fesd_settings_default(fesd_settings *s) {
   s->exit_rows = 1;
   s->max_splits = 6;
   s->sensitivities = 0;
+  s->max_sweeps = 8;
   fesd_ncp_settings_default(&s->ncp);
   return FESD_OK;
 }
@@ -33,6 +34,7 @@ static int validate_settings(const fesd_settings *s) {
   if (!(s->newton_tol > 0) || !(s->cc_tol > 0) || !(s->active_tol > 0)) return FESD_ERR_INVALID_ARG;
   if (s->max_iter_first < 1 || s->max_iter < 1) return FESD_ERR_INVALID_ARG;
   if (s->max_splits < 0 || s->max_splits > 12) return FESD_ERR_INVALID_ARG;
+  if (s->max_sweeps < 1 || s->max_sweeps > 50) return FESD_ERR_INVALID_ARG;
   return FESD_OK;
 }
 
@@ -164,7 +166,7 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   it->pt_src = malloc((N * (s + 1) + 1) * sizeof(int));
   it->kb = malloc((N + 1) * sizeof(int));
   it->sw_at = malloc((N + 1) * sizeof(int));
-  it->act = malloc(N * nth);
+  it->act = malloc(N * s * nth); /* per stage */
   it->act0 = malloc(nth);
   it->cand = malloc(nth);
   it->bmode = calloc(N + 1, sizeof(int));

@@ -166,7 +166,7 @@ static int fb_path(fesd_integrator *it, double T, fesd_step_info *info) {
 
 /* ---------- active-set path ---------- */
 
-/* Solve with the per-element active sets it->act and boundary modes it->bmode from the
+/* Solve with the per-stage active sets it->act and boundary modes it->bmode from the
  * guess in z; success means converged and sign-verified (v reports a violation). */
 static int active_solve(fesd_integrator *it, double *z, int max_iter, fesd__violation *v,
                         fesd_step_info *info) {
@@ -176,7 +176,7 @@ static int active_solve(fesd_integrator *it, double *z, int max_iter, fesd__viol
   if (st) return st;
   for (int n = 0; n < it->N; n++)
     if (!(z[it->sys.ho[n]] > 0)) return FESD_ERR_STEP_FAILED;
-  fesd__find_violation(it, z, it->act, v);
+  fesd__find_violation(it, z, it->act, it->set.method == FESD_METHOD_STANDARD, v);
   return v->found ? FESD_ERR_STEP_FAILED : FESD_OK;
 }
 
@@ -210,14 +210,82 @@ static const double *state_near(fesd_integrator *it, const double *z, double t) 
   return best;
 }
 
+/* Candidate active sets of subsystem v->sys after the violation v, best first: an exit
+ * drops the mode; an entering mode j replaces the set (crossing) or joins it (sliding), in
+ * the order given by the direction of f_j at x. cur: the active flags before. */
+static int candidates(fesd_integrator *it, const fesd__violation *v, const unsigned char *cur,
+                      const double *x, unsigned char cands[2][64], int *i_old_out) {
+  const fesd__model *m = &it->model;
+  const int k0 = m->th_off[v->sys], k1 = m->th_off[v->sys + 1];
+  if (k1 - k0 > 64) return 0;
+  if (!v->enter) {
+    for (int i = k0; i < k1; i++) cands[0][i - k0] = cur[i] && i != v->mode;
+    return 1;
+  }
+  int i_old = -1;
+  for (int i = k0; i < k1; i++)
+    if (cur[i] && i_old < 0) i_old = i;
+  if (i_old < 0) return 0;
+  int cross = 1;
+  if (crossing_first(it, x, i_old, v->mode, &cross)) return 0;
+  for (int i = k0; i < k1; i++) {
+    cands[!cross][i - k0] = i == v->mode;           /* crossing: j replaces the set */
+    cands[cross][i - k0] = cur[i] || i == v->mode;  /* sliding: j joins the set */
+  }
+  *i_old_out = i_old;
+  return 2;
+}
+
+/* Standard method: its equations hold stage by stage, so a violation at stage p0 changes the
+ * active set of that stage and of all later ones; repeated for later violations (a few
+ * rounds), each solve smooth. Falls back to the FB path when this does not settle. */
+static int std_switch(fesd_integrator *it, fesd__violation v, fesd_step_info *info) {
+  fesd__system *S = &it->sys;
+  const int nth = S->nth, ns = S->N * S->s;
+  const fesd__model *m = &it->model;
+  double *z = it->z;
+  for (int round = 0; round < 4; round++) {
+    const int p0 = v.stage, k0 = m->th_off[v.sys], k1 = m->th_off[v.sys + 1];
+    if (p0 >= ns) return FESD_ERR_STEP_FAILED;
+    unsigned char cands[2][64];
+    int i_old = -1;
+    const double *x = S->X + (size_t)p0 * S->nx; /* the stage state of the last solve */
+    int nc = candidates(it, &v, it->act + (size_t)p0 * nth, x, cands, &i_old);
+    if (nc == 0) return FESD_ERR_STEP_FAILED;
+    memcpy(it->zpred, z, (size_t)S->n * sizeof(double));
+    int advanced = 0;
+    for (int c = 0; c < nc && !advanced; c++) {
+      memcpy(z, it->zpred, (size_t)S->n * sizeof(double));
+      for (int p = p0; p < ns; p++) memcpy(it->act + (size_t)p * nth + k0, cands[c], (size_t)(k1 - k0));
+      fesd__impose_active(it, z, it->act);
+      int st = fesd__consistent_guess(it, z);
+      if (st) return st;
+      fesd__violation v2;
+      v2.found = 0;
+      st = active_solve(it, z, it->set.max_iter, &v2, info);
+      if (cb_failed(st)) return st;
+      if (st == FESD_OK) {
+        info->switch_step = 1; /* the active set changed inside the step */
+        return FESD_OK;
+      }
+      if (v2.found && v2.stage > p0) {
+        v = v2;
+        advanced = 1;
+      }
+    }
+    if (!advanced) return FESD_ERR_STEP_FAILED;
+  }
+  return FESD_ERR_STEP_FAILED;
+}
+
 static int active_path(fesd_integrator *it, double T, fesd_step_info *info) {
   fesd__system *S = &it->sys;
-  const int N = S->N, nth = S->nth;
+  const int N = S->N, nth = S->nth, s = S->s;
   double *z = it->z, *zf = it->zfast;
   fesd__violation v;
   int st;
-  /* fast path: the start's active set in every element, equal h */
-  for (int n = 0; n < N; n++) memcpy(it->act + (size_t)n * nth, it->act0, (size_t)nth);
+  /* fast path: the start's active set at every stage, equal h */
+  for (int p = 0; p < N * s; p++) memcpy(it->act + (size_t)p * nth, it->act0, (size_t)nth);
   memset(it->bmode, 0, (size_t)(N + 1) * sizeof(int));
   memcpy(z, it->z0, (size_t)S->n * sizeof(double));
   fesd__impose_active(it, z, it->act);
@@ -225,7 +293,7 @@ static int active_path(fesd_integrator *it, double T, fesd_step_info *info) {
   st = active_solve(it, z, it->set.max_iter_first, &v, info);
   if (st == FESD_OK) return FESD_OK;
   if (st != FESD_ERR_STEP_FAILED || !v.found) return cb_failed(st) ? st : FESD_ERR_STEP_FAILED;
-  if (it->set.method == FESD_METHOD_STANDARD) return FESD_ERR_STEP_FAILED;
+  if (it->set.method == FESD_METHOD_STANDARD) return std_switch(it, v, info);
   memcpy(zf, z, (size_t)S->n * sizeof(double));
   /* candidate active sets after the switch */
   const fesd__model *m = &it->model;
@@ -261,9 +329,11 @@ static int active_path(fesd_integrator *it, double T, fesd_step_info *info) {
     memcpy(z, zf, (size_t)S->n * sizeof(double));
     memset(it->bmode, 0, (size_t)(N + 1) * sizeof(int));
     for (int n = 0; n < N; n++) {
-      unsigned char *a = it->act + (size_t)n * nth;
-      memcpy(a, it->act0, (size_t)nth);
-      if (at_start || n >= kb) memcpy(a + k0, cands[c], (size_t)(k1 - k0));
+      for (int j = 0; j < s; j++) {
+        unsigned char *a = it->act + (size_t)(n * s + j) * nth;
+        memcpy(a, it->act0, (size_t)nth);
+        if (at_start || n >= kb) memcpy(a + k0, cands[c], (size_t)(k1 - k0));
+      }
       z[S->ho[n]] = at_start ? T / N : (n < kb ? tstar / kb : (T - tstar) / (N - kb));
     }
     if (!at_start) {

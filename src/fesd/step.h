@@ -16,6 +16,7 @@ typedef struct {
   int sys;
   int enter;    /* 1: an inactive mode's lambda went negative; 0: an active theta did */
   int element;  /* element where it was detected */
+  int stage;    /* stage index n*s + j of the violating point (n*s + s: element end) */
 } fesd__violation;
 
 /* active.c */
@@ -25,7 +26,7 @@ void fesd__impose_active(fesd_integrator *it, double *z, const unsigned char *ac
 int fesd__rows_active(fesd_integrator *it, const unsigned char *act, const int *bmode,
                       const int *exit_mode);
 int fesd__find_violation(fesd_integrator *it, const double *z, const unsigned char *act,
-                         fesd__violation *v);
+                         int strict, fesd__violation *v);
 /* FESD_ERR_STEP_FAILED if the collocation polynomial enters a region between stage points. */
 int fesd__interior_check(fesd_integrator *it, const double *z);
 /* guess.c */
