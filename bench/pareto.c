@@ -1,7 +1,7 @@
 /* Speed against error (Pareto): CPU time per integration vs error, FESD against standard
  * time-stepping (same tableau, same N_FE = 2, same solver), Radau IIA s = 1..5, N_sim
  * doubling. Problems:
- *   oscillator    T = 2, crossing at t = 1; error = |x(T) - exact|_inf
+ *   oscillator    T = pi/2, crossing at t = 1; error = |x(T) - exact|_inf
  *   sign-c        T = 2.1, leaves a sliding mode at t = 1; error = |x(T) - exact|_inf;
  *                 third curve: FESD with the paper's formulation at the exit (exit_rows = 0)
  *   ocp-dynamics  T = 4, two sliding entries (t1 ~ 0.9775, 2 pi / 3); both methods give x(T)

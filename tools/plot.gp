@@ -40,7 +40,7 @@ set xlabel "CPU time per integration [ms]"
 set key
 set key top right font ",9"
 do for [p in "oscillator sign-c ocp-dynamics"] {
-  set title (p eq "ocp-dynamics" ? "ocp-dynamics (T = 4): error of the switch times" : p eq "sign-c" ? "sign-c (T = 2.1, sliding exit): |x(T) - x^*(T)|" : "oscillator (T = 2): |x(T) - x^*(T)|")
+  set title (p eq "ocp-dynamics" ? "ocp-dynamics (T = 4): error of the switch times" : p eq "sign-c" ? "sign-c (T = 2.1, sliding exit): |x(T) - x^*(T)|" : "oscillator (T = {/Symbol p}/2): |x(T) - x^*(T)|")
   set ylabel (p eq "ocp-dynamics" ? "max_k |t_k - t_k^*|" : "error at T")
   plot for [v=1:3] for [s=1:5] f using (sel("problem", p) && sel("variant", word(vars,v)) && column("s")==s ? column("cpu_ms") : NaN):(floor16(column("err"))) \
          with linespoints lc rgb word(cols,v) pt s ps 0.7 notitle, \
@@ -134,10 +134,12 @@ f = dir."/growth.csv"
 set output dir."/growth.png"
 set terminal pngcairo size 800,600 font ",10"
 unset multiplot
+set autoscale
+set xrange [5:2000]
 set logscale xy
 set format x "%g"
 set format y "10^{%L}"
-set key top left
+set key inside top left
 set title "Friction chain: CPU time per step against n (growth.csv)"
 set xlabel "n (masses = switching subsystems; n_x = 2n)"
 set ylabel "ms per step"
