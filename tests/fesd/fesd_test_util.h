@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "fesd.h"
+#include "../check.h"
 #include "problems/problems.h"
 
 #define TU_MAX_EL 20000
@@ -86,13 +87,6 @@ static inline int tu_integrate(const fesd_problem *P, const fesd_settings *set, 
   return r->status = st;
 }
 
-#define TU_CHECK(cond, ...)            \
-  do {                                 \
-    if (!(cond)) {                     \
-      printf("FAIL: " __VA_ARGS__);    \
-      printf("\n");                    \
-      fails++;                         \
-    }                                  \
-  } while (0)
+#define TU_CHECK FESD_TEST_CHECK
 
 #endif

@@ -13,16 +13,10 @@
 #include <string.h>
 
 #include "fesd.h"
+#include "../check.h"
 
 static int fails = 0;
-#define CHECK(cond, ...)            \
-  do {                              \
-    if (!(cond)) {                  \
-      printf("FAIL: " __VA_ARGS__); \
-      printf("\n");                 \
-      fails++;                      \
-    }                               \
-  } while (0)
+#define CHECK FESD_TEST_CHECK
 
 /* ---- test model: the oscillator of the paper (DESIGN.md section 5) with a fault injector ---- */
 enum { CB_FIELD, CB_SWITCH, CB_FIELD_JAC, CB_SWITCH_JAC, CB_N };

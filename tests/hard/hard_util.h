@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "fesd.h"
+#include "../check.h"
 
 #define HD_MAX_NX 8
 #define HD_PI 3.14159265358979323846
@@ -110,13 +111,6 @@ static inline double hd_event_time(const hd_run *r, int sys, int kind, double t_
   return NAN;
 }
 
-#define HD_CHECK(cond, ...)         \
-  do {                              \
-    if (!(cond)) {                  \
-      printf("FAIL: " __VA_ARGS__); \
-      printf("\n");                 \
-      fails++;                      \
-    }                               \
-  } while (0)
+#define HD_CHECK FESD_TEST_CHECK
 
 #endif
