@@ -236,17 +236,11 @@ int fesd__interior_check(fesd_integrator *it, const double *z) {
     const double *xn = n == 0 ? S->x0 : z + S->xo[n - 1], h = z[S->ho[n]];
     for (int p = 0; p + 1 < nn; p++) {
       const double tau = 0.5 * (nodes[p] + nodes[p + 1]);
+      double w[FESD_RK_MAX_STAGES];
+      fesd__colloc_weights(it, tau, w);
       memcpy(x, xn, (size_t)nx * sizeof(double));
-      for (int j = 0; j < s; j++) {
-        double w = 0; /* int_0^tau l_j by the Gauss rule (exact) */
-        for (int q = 0; q < it->quad.s; q++) {
-          double sg = tau * it->quad.c[q], l = 1;
-          for (int r = 0; r < s; r++)
-            if (r != j) l *= (sg - T->c[r]) / (T->c[j] - T->c[r]);
-          w += tau * it->quad.b[q] * l;
-        }
-        for (int r = 0; r < nx; r++) x[r] += h * w * z[fesd__v(S, n, j) + r];
-      }
+      for (int j = 0; j < s; j++)
+        for (int r = 0; r < nx; r++) x[r] += h * w[j] * z[fesd__v(S, n, j) + r];
       int st = fesd__model_g(&it->model, x, S->u, g);
       if (st) return st;
       for (int k = 0; k < m->nsys; k++) {

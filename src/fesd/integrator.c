@@ -362,17 +362,25 @@ int fesd_dense_output(const fesd_integrator *it, double t, double *x) {
   while (e + 1 < it->n_el && t >= it->rec_t[e + 1]) e++;
   const int s = T->s, nx = it->nx;
   const double h = it->rec_h[e], tau = h > 0 ? fmin(fmax((t - it->rec_t[e]) / h, 0.0), 1.0) : 0.0;
+  double w[FESD_RK_MAX_STAGES];
+  fesd__colloc_weights(it, tau, w);
   memcpy(x, it->rec_x + (size_t)e * nx, (size_t)nx * sizeof(double));
   for (int j = 0; j < s; j++) {
-    double w = 0; /* int_0^tau l_j */
-    for (int q = 0; q < it->quad.s; q++) {
-      double sg = tau * it->quad.c[q], l = 1;
-      for (int m = 0; m < s; m++)
-        if (m != j) l *= (sg - T->c[m]) / (T->c[j] - T->c[m]);
-      w += tau * it->quad.b[q] * l;
-    }
     const double *v = it->rec_v + ((size_t)e * s + j) * nx;
-    for (int r = 0; r < nx; r++) x[r] += h * w * v[r];
+    for (int r = 0; r < nx; r++) x[r] += h * w[j] * v[r];
   }
   return FESD_OK;
+}
+
+void fesd__colloc_weights(const fesd_integrator *it, double tau, double *w) {
+  const fesd_tableau *T = &it->tab;
+  for (int j = 0; j < T->s; j++) {
+    w[j] = 0; /* int_0^tau l_j by the Gauss rule (exact: degree s - 1) */
+    for (int q = 0; q < it->quad.s; q++) {
+      double sg = tau * it->quad.c[q], l = 1;
+      for (int m = 0; m < T->s; m++)
+        if (m != j) l *= (sg - T->c[m]) / (T->c[j] - T->c[m]);
+      w[j] += tau * it->quad.b[q] * l;
+    }
+  }
 }

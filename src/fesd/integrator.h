@@ -52,6 +52,9 @@ struct fesd_integrator {
   double sum_iter_ord, sum_iter_sw;
 };
 
+/* w_j = int_0^tau l_j (Lagrange basis on the nodes c): the collocation polynomial of an
+ * element is x_n + h sum_j w_j(tau) v_j. w has s entries. */
+void fesd__colloc_weights(const fesd_integrator *it, double tau, double *w);
 void fesd__save(fesd_integrator *it, fesd__saved *b);
 void fesd__load(fesd_integrator *it, const fesd__saved *b);
 
