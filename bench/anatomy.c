@@ -36,8 +36,8 @@ int __wrap_fesd_ncp_solve_homotopy(fesd_ncp *ws, double *z, fesd_ncp_info *info)
 int __wrap_fesd_ncp_set_rows(fesd_ncp *ws, const unsigned char *eq, const unsigned char *pm);
 
 static struct {
-  double wall, total, eval, linsolve, set_rows;
-  long factorizations, solves, set_rows_calls;
+  double wall, total, eval, linsolve, set_rows, iter_time;
+  long factorizations, solves, set_rows_calls, iterations;
   int max_rows;
 } acc;
 
@@ -52,6 +52,8 @@ static void account(fesd_ncp *ws, const fesd_ncp_info *in) {
   acc.eval += in->time_eval;
   acc.linsolve += in->time_linsolve;
   acc.factorizations += in->factorizations;
+  acc.iter_time += in->time_iterations;
+  acc.iterations += in->iterations;
   acc.solves++;
   int m = fesd_ncp_rows(ws);
   if (m > acc.max_rows) acc.max_rows = m;
@@ -206,14 +208,17 @@ typedef struct {
   double share, calls; /* share of the CPU time, calls per integration */
 } model_cost;
 
-/* One CSV row: P integrated with the case's settings and backend b. The model cost is measured
- * when mc->share is NaN (first backend) and reused for the others (the calls do not depend on
- * the backend). */
-static void measure(FILE *csv, const fesd_problem *P, const bench_case *c, fesd_ncp_backend b, model_cost *mc) {
+/* One CSV row: P integrated with the case's settings, backend b and at most `sweeps`
+ * consistency sweeps per step (8: the default; 1: Newton-driven, nearly every step iterates).
+ * The model cost is measured when mc->share is NaN (first backend) and reused for the others
+ * (the calls do not depend on the backend). */
+static void measure(FILE *csv, const fesd_problem *P, const bench_case *c, fesd_ncp_backend b, int sweeps,
+                    model_cost *mc) {
   fesd_settings set;
   fesd_settings_default(&set);
   set.method = c->method;
   set.stages = c->s;
+  set.max_sweeps = sweeps;
   set.ncp.backend = b;
   fesd_integrator *it = bench_create(P, &set);
   if (!it) return;
@@ -229,29 +234,35 @@ static void measure(FILE *csv, const fesd_problem *P, const bench_case *c, fesd_
   double sh_eval = acc.eval / acc.wall, sh_lin = acc.linsolve / acc.wall, sh_rows = acc.set_rows / acc.wall;
   double sh_solver = (acc.total - acc.eval - acc.linsolve) / acc.wall;
   double sh_out = 1 - (acc.total + acc.set_rows) / acc.wall;
+  /* the library's own factorization + solve of the step Jacobian, and one iteration of its
+   * Newton loop (both wall time inside the solver, summed over the timed integrations) */
   double us_fact = 1e6 * acc.linsolve / (double)(acc.factorizations ? acc.factorizations : 1);
+  double us_iter = acc.iterations ? 1e6 * acc.iter_time / (double)acc.iterations : NAN;
   if (isnan(mc->share) && !st) mc->share = model_time(P, &set, c->nsim, &mc->calls) / t;
   double lu = n > 0 ? time_lu(n) : NAN, per_newton = t / (r.stats.newton_iter ? r.stats.newton_iter : 1);
   const char *mname = c->method ? "standard" : "fesd", *bname = fesd_ncp_backend_name(b);
-  fprintf(csv, "%s,%s,%d,%d,%s,%d,%d,%.3f,%.3f,%.3f,%.3f,%.4f,%.2f,%.2f,", P->name, mname, c->s, c->nsim, bname, n,
-          r.stats.steps, (double)r.stats.newton_iter / steps, (double)r.stats.factorizations / steps, solves, rows,
-          1e3 * t, 1e6 * t / steps, 1e6 * per_newton);
-  fprintf(csv, "%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.1f,%.2f,%.2f,%.3f,%.3f,%d\n", sh_eval, sh_lin, sh_solver, sh_rows,
-          sh_out, mc->share, mc->calls / steps, us_fact, 1e6 * lu, per_newton / lu, 1e-6 * us_fact / lu, st);
-  printf("%-12s %-8s %d %3d %-8s %4d | %7.1f %5.2f | %4.0f%% %6.0f%% %5.0f%% %6.0f%% %6.0f%% | %3.0f%% | %8.1f %6.1f "
-         "%5.2f%s\n", P->name, mname, c->s, c->nsim, bname, n, 1e6 * t / steps, (double)r.stats.newton_iter / steps,
-         100 * sh_eval, 100 * sh_lin, 100 * sh_solver, 100 * sh_rows, 100 * sh_out, 100 * mc->share,
-         1e6 * per_newton, 1e6 * lu, per_newton / lu, st ? "  FAILED" : "");
+  fprintf(csv, "%s,%s,%d,%d,%d,%s,%d,%d,%.3f,%.3f,%.3f,%.3f,%.4f,%.2f,%.2f,%.2f,", P->name, mname, c->s, c->nsim,
+          sweeps, bname, n, r.stats.steps, (double)r.stats.newton_iter / steps, (double)r.stats.factorizations / steps,
+          solves, rows, 1e3 * t, 1e6 * t / steps, 1e6 * per_newton, us_iter);
+  fprintf(csv, "%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.1f,%.2f,%.2f,%.3f,%.3f,%.3f,%.3f,%d\n", sh_eval, sh_lin, sh_solver,
+          sh_rows, sh_out, mc->share, mc->calls / steps, us_fact, 1e6 * lu, per_newton / lu, 1e-6 * us_iter / lu,
+          us_iter / us_fact, 1e-6 * us_fact / lu, st);
+  printf("%-12s %-8s %d %3d %d %-7s %3d | %6.1f %5.2f | %3.0f%% %3.0f%% %3.0f%% %3.0f%% %3.0f%% | %3.0f%% | %7.1f %6.1f "
+         "%6.1f %6.1f | %5.2f %5.2f %5.2f%s\n", P->name, mname, c->s, c->nsim, sweeps, bname, n, 1e6 * t / steps,
+         (double)r.stats.newton_iter / steps, 100 * sh_eval, 100 * sh_lin, 100 * sh_solver, 100 * sh_rows, 100 * sh_out,
+         100 * mc->share, 1e6 * per_newton, us_iter, us_fact, 1e6 * lu, per_newton / lu, 1e-6 * us_iter / lu,
+         us_iter / us_fact, st ? "  FAILED" : "");
   fflush(stdout);
 }
 
 int main(int argc, char **argv) {
-  if (bench_init(argc, argv, "cost anatomy per backend, against one LAPACK LU")) return 1;
+  if (bench_init(argc, argv, "cost anatomy per backend, against one LU + solve")) return 1;
   FILE *csv = bench_csv("anatomy.csv",
-                        "problem,method,s,nsim,backend,n,steps,newton_per_step,fact_per_step,solves_per_step,"
-                        "set_rows_per_step,cpu_ms,us_per_step,us_per_newton,share_eval,share_linsolve,"
-                        "share_solver_other,share_set_rows,share_outside,share_model,model_calls_per_step,us_lib_factor_solve,"
-                        "us_lapack_lu,ratio_newton_to_lu,ratio_factor_to_lu,status");
+                        "problem,method,s,nsim,max_sweeps,backend,n,steps,newton_per_step,fact_per_step,solves_per_step,"
+                        "set_rows_per_step,cpu_ms,us_per_step,us_per_newton,us_per_iteration,share_eval,share_linsolve,"
+                        "share_solver_other,share_set_rows,share_outside,share_model,model_calls_per_step,"
+                        "us_lib_factor_solve,us_lapack_lu,ratio_newton_to_lu,ratio_iteration_to_lu,"
+                        "ratio_iteration_to_lib,ratio_factor_to_lu,status");
   if (!csv) return 1;
   static const bench_case cases[] = {
       {"oscillator", FESD_METHOD_FESD, 5, 10},     {"oscillator", FESD_METHOD_FESD, 3, 40},
@@ -260,14 +271,18 @@ int main(int argc, char **argv) {
       {"ocp-dynamics", FESD_METHOD_STANDARD, 2, 40}};
   static const fesd_ncp_backend backends[] = {FESD_NCP_BACKEND_AUTO, FESD_NCP_BACKEND_DENSE, FESD_NCP_BACKEND_KLU,
                                               FESD_NCP_BACKEND_UMFPACK};
+  static const int sweeps[] = {8, 1};
   const int nc = bench_opt.quick ? 2 : 7, nb = bench_opt.quick ? 2 : 4;
-  printf("%-12s %-8s s  N   backend    n | us/step newton/step | eval  linsolve solver set_rows outside | model"
-         " | us/newton  LU us  ratio\n", "problem", "method");
+  printf("all/newton: integration time per Newton iteration; iteration: one iteration of the Newton loop;\n"
+         "lib LU: the backend's factorization + solve of the same Jacobian; LAPACK: dgetrf + dgetrs of the same order\n");
+  printf("%-12s %-8s s  N sw backend   n | us/step newt/st | eval lin  slv rows out | model |"
+         " all/newt iterat lib LU LAPACK | all/LAPACK iter/LAPACK iter/lib\n", "problem", "method");
   for (int c = 0; c < nc; c++) {
     fesd_problem P;
     fesd_problem_get(cases[c].prob, &P);
     model_cost mc = {NAN, NAN};
-    for (int b = 0; b < nb; b++) measure(csv, &P, &cases[c], backends[b], &mc);
+    for (int w = 0; w < 2; w++)
+      for (int b = 0; b < nb; b++) measure(csv, &P, &cases[c], backends[b], sweeps[w], &mc);
   }
   fclose(csv);
   return 0;

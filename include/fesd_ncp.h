@@ -132,6 +132,9 @@ typedef struct {
   double time_total;     /**< seconds (wall clock) */
   double time_eval;      /**< seconds in the user callback */
   double time_linsolve;  /**< seconds in factorizations and solves */
+  double time_iterations; /**< seconds inside the Newton/LM iterations (Jacobian assembly, factorization, solve,
+                             line search with its evaluations); the rest of time_total is the first residual
+                             and the convergence test, so time_iterations / iterations is the cost of one iteration */
   int history_len;       /**< entries used in residual_history */
   double residual_history[FESD_NCP_HISTORY]; /**< ||F||_inf at the start of each iteration, then final (per stage; the most recent entries when more) */
 } fesd_ncp_info;

@@ -217,6 +217,19 @@ int fesd__find_violation(fesd_integrator *it, const double *z, const unsigned ch
  * polynomial u(tau) = x_n + h sum_j (int_0^tau l_j) v_j is checked at the midpoints between
  * its nodes 0, c_1..c_s (, 1): some inactive mode's indicator below every active one by more
  * than 1e3 cc_tol (interpolation error allowance) rejects the step, which is then halved. */
+void fesd__interior_setup(fesd_integrator *it) {
+  const fesd_tableau *T = &it->tab;
+  double nodes[FESD_RK_MAX_STAGES + 2];
+  int nn = 0;
+  nodes[nn++] = 0.0;
+  for (int j = 0; j < T->s; j++)
+    if (T->c[j] > nodes[nn - 1]) nodes[nn++] = T->c[j];
+  if (nodes[nn - 1] < 1.0) nodes[nn++] = 1.0;
+  it->n_mid = nn - 1;
+  for (int p = 0; p + 1 < nn; p++)
+    fesd__colloc_weights(it, 0.5 * (nodes[p] + nodes[p + 1]), it->mid_w + p * FESD_RK_MAX_STAGES);
+}
+
 int fesd__interior_check(fesd_integrator *it, const double *z) {
   const fesd_tableau *T = &it->tab;
   if (T->family != FESD_RK_RADAU_IIA && T->family != FESD_RK_GAUSS_LEGENDRE &&
@@ -224,32 +237,27 @@ int fesd__interior_check(fesd_integrator *it, const double *z) {
     return FESD_OK;
   fesd__system *S = &it->sys;
   const fesd__model *m = &it->model;
-  const int s = S->s, nx = S->nx, nth = S->nth;
-  const double tol = 1e3 * it->set.cc_tol;
-  double *g = it->gbuf, *x = it->gbuf + nth, nodes[FESD_RK_MAX_STAGES + 2];
-  int nn = 0;
-  nodes[nn++] = 0.0;
-  for (int j = 0; j < s; j++)
-    if (T->c[j] > nodes[nn - 1]) nodes[nn++] = T->c[j];
-  if (nodes[nn - 1] < 1.0) nodes[nn++] = 1.0;
+  const int s = S->s, nx = S->nx;
+  const double tol = 1e3 * it->set.cc_tol, atol = it->set.active_tol;
+  double *g = it->gbuf, *x = it->gbuf + S->nth;
   for (int n = 0; n < S->N; n++) {
     const double *xn = n == 0 ? S->x0 : z + S->xo[n - 1], h = z[S->ho[n]];
-    for (int p = 0; p + 1 < nn; p++) {
-      const double tau = 0.5 * (nodes[p] + nodes[p + 1]);
-      double w[FESD_RK_MAX_STAGES];
-      fesd__colloc_weights(it, tau, w);
+    for (int p = 0; p < it->n_mid; p++) {
+      const double *w = it->mid_w + p * FESD_RK_MAX_STAGES;
       memcpy(x, xn, (size_t)nx * sizeof(double));
-      for (int j = 0; j < s; j++)
-        for (int r = 0; r < nx; r++) x[r] += h * w[j] * z[fesd__v(S, n, j) + r];
+      for (int j = 0; j < s; j++) {
+        const double hw = h * w[j], *v = z + fesd__v(S, n, j);
+        for (int r = 0; r < nx; r++) x[r] += hw * v[r];
+      }
       int st = fesd__model_g(&it->model, x, S->u, g);
       if (st) return st;
       for (int k = 0; k < m->nsys; k++) {
         double gact = INFINITY, gin = INFINITY;
         for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) {
           int act = 0;
-          for (int j = 0; j < s; j++) act |= z[fesd__th(S, n, j) + i] > it->set.active_tol;
-          if (act) gact = fmin(gact, g[i]);
-          else gin = fmin(gin, g[i]);
+          for (int j = 0; j < s; j++) act |= z[fesd__th(S, n, j) + i] > atol;
+          if (act) gact = g[i] < gact ? g[i] : gact;
+          else gin = g[i] < gin ? g[i] : gin;
         }
         if (gin < gact - tol) return FESD_ERR_STEP_FAILED;
       }

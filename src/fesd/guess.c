@@ -49,9 +49,10 @@ int fesd__consistent_guess(fesd_integrator *it, double *z) {
         memset(v, 0, (size_t)nx * sizeof(double));
         for (int i = 0; i < nth; i++)
           if (th[i] != 0.0) fesd__F_axpy(m, &pe, i, th[i], v);
-        for (int r = 0; r < nx; r++) {
-          change = fmax(change, fabs(v[r] - vold[r]));
-          vmax = fmax(vmax, fabs(v[r]));
+        for (int r = 0; r < nx; r++) { /* (no fmax: a libm call here, v is finite) */
+          const double dv = fabs(v[r] - vold[r]), av = fabs(v[r]);
+          change = dv > change ? dv : change;
+          vmax = av > vmax ? av : vmax;
         }
       }
       if (!frozen && !S->tab.is_explicit && !(change <= 2 * prev || change <= 1e-10)) {

@@ -103,6 +103,7 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   fesd__system *S = &it->sys;
   it->tab = tab;
   fesd_tableau_get(FESD_RK_GAUSS_LEGENDRE, tab.s, &it->quad);
+  fesd__interior_setup(it);
   it->n = S->n;
   it->nx = model->nx;
   it->nu = model->nu;

@@ -46,6 +46,10 @@ struct fesd_integrator {
   int cap_el, n_el;
   double *rec_h, *rec_t, *rec_x, *rec_th, *rec_la, *rec_mu, *rec_v;
   fesd_tableau tab, quad; /* the method, and a Gauss rule for dense output */
+  /* interior sign check: collocation weights at the midpoints between consecutive
+   * nodes {0, c_j, 1} (fixed by the tableau, so computed once at create) */
+  int n_mid;
+  double mid_w[(FESD_RK_MAX_STAGES + 1) * FESD_RK_MAX_STAGES];
   fesd_event events[FESD_MAX_EVENTS_PER_STEP];
   int n_events;
   fesd_stats stats;
@@ -55,6 +59,8 @@ struct fesd_integrator {
 /* w_j = int_0^tau l_j (Lagrange basis on the nodes c): the collocation polynomial of an
  * element is x_n + h sum_j w_j(tau) v_j. w has s entries. */
 void fesd__colloc_weights(const fesd_integrator *it, double tau, double *w);
+/* Fill n_mid and mid_w (active.c). */
+void fesd__interior_setup(fesd_integrator *it);
 void fesd__save(fesd_integrator *it, fesd__saved *b);
 void fesd__load(fesd_integrator *it, const fesd__saved *b);
 

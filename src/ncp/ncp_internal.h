@@ -8,7 +8,7 @@
 /* Accumulated statistics of one public call (copied into fesd_ncp_info). */
 typedef struct {
   int iterations, stages, factorizations, evals, jac_evals, backtracks;
-  double time_eval, time_linsolve;
+  double time_eval, time_linsolve, time_iter;
 } fesd__ncp_stats;
 
 struct fesd_ncp {

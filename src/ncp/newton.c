@@ -52,9 +52,13 @@ static double dot(const double *x, const double *y, int n) {
   return s;
 }
 
+/* (no fmax/fmin in these loops: they are libm calls; x is finite here) */
 static double norm_inf(const double *x, int n) {
   double s = 0.0;
-  for (int i = 0; i < n; i++) s = fmax(s, fabs(x[i]));
+  for (int i = 0; i < n; i++) {
+    const double a = fabs(x[i]);
+    s = a > s ? a : s;
+  }
   return s;
 }
 
@@ -66,7 +70,10 @@ static void swap(double **a, double **b) {
 
 static void project(const fesd_ncp *ws, double *z) {
   if (!ws->has_box) return;
-  for (int i = 0; i < ws->n; i++) z[i] = fmin(fmax(z[i], ws->lb[i]), ws->ub[i]);
+  for (int i = 0; i < ws->n; i++) {
+    const double lo = z[i] < ws->lb[i] ? ws->lb[i] : z[i];
+    z[i] = lo > ws->ub[i] ? ws->ub[i] : lo;
+  }
 }
 
 static void history_push(fesd_ncp_info *info, double r) {
@@ -208,10 +215,9 @@ static int stage(fesd_ncp *ws, double *z, double sigma, double tol, fesd__ncp_st
   int stall = 0, status = FESD_ERR_MAX_ITER, rc;
 
   st->stages++;
-  if (!*cached) {
-    rc = fesd__ncp_call(ws, z, ws->raw_c, ws->jac_c, st);
+  if (!*cached) { /* residual only: warm starts are often converged already */
+    rc = fesd__ncp_call(ws, z, ws->raw_c, NULL, st);
     if (rc != FESD_OK) return rc;
-    ss.jac_ok = 1;
   }
   *cached = 0;
   fesd__ncp_residual(ws, ws->raw_c, sigma, ws->F_c);
@@ -233,6 +239,7 @@ static int stage(fesd_ncp *ws, double *z, double sigma, double tol, fesd__ncp_st
       status = lm && angle <= LM_STALL_ANGLE ? FESD_ERR_INCONSISTENT : FESD_ERR_MAX_ITER;
       break;
     }
+    const double t_it = fesd__wall_time();
     if (!ss.jac_ok) {
       rc = fesd__ncp_call(ws, z, ws->raw_c, ws->jac_c, st);
       if (rc != FESD_OK) return rc;
@@ -251,6 +258,7 @@ static int stage(fesd_ncp *ws, double *z, double sigma, double tol, fesd__ncp_st
       angle = jnorm > 0.0 ? gnorm / (jnorm * sqrt(ss.f2)) : 0.0;
       if (angle <= LM_STATIONARY) {
         status = FESD_ERR_INCONSISTENT;
+        st->time_iter += fesd__wall_time() - t_it;
         break;
       }
       rc = lm_step(ws, ws->active, mu, jnorm, st);
@@ -260,6 +268,7 @@ static int stage(fesd_ncp *ws, double *z, double sigma, double tol, fesd__ncp_st
     }
     if (rc != FESD_OK) {
       status = rc;
+      st->time_iter += fesd__wall_time() - t_it;
       break;
     }
     const double f2_old = ss.f2;
@@ -280,6 +289,7 @@ static int stage(fesd_ncp *ws, double *z, double sigma, double tol, fesd__ncp_st
       rc = line_search(ws, z, &ss, s->max_backtracks, st, &ntrial, &step, &psi_first);
     }
     log_iteration(ws, it, &ss, gnorm, rc == FESD_OK ? step : 0.0, ntrial, dir);
+    st->time_iter += fesd__wall_time() - t_it;
     if (rc != FESD_OK) {
       status = (rc == FESD_ERR_LINE_SEARCH && lm && angle <= LM_STALL_ANGLE)
                    ? FESD_ERR_INCONSISTENT
@@ -339,6 +349,7 @@ static int finish(const fesd_ncp *ws, fesd_ncp_info *info, const fesd__ncp_stats
   info->residual = res;
   info->time_eval = st->time_eval;
   info->time_linsolve = st->time_linsolve;
+  info->time_iterations = st->time_iter;
   info->time_total = fesd__wall_time() - t0;
   return rc;
 }

@@ -168,8 +168,9 @@ static void nan_at_call(lcp_t *l, int k) {
   l->nan_after = k;
 }
 
-/* NaN (or Inf in the Jacobian) at the first two trial points of the first iteration
- * (calls 2 and 3): they must only shorten the step. */
+/* NaN (or Inf in the Jacobian) at the first two trial points of the first iteration: they
+ * must only shorten the step. Call 1 is the residual at the start, call 2 its Jacobian (the
+ * solver asks for it only when the start is not converged), calls 3 and 4 the trials. */
 typedef struct {
   lcp_t *lcp;
   int calls, nan_trials;
@@ -178,7 +179,7 @@ static int nanzone_eval(const double *z, double *raw, double *jac, void *user) {
   nanzone_t *u = (nanzone_t *)user;
   int rc = lcp_eval(z, raw, jac, u->lcp);
   u->calls++;
-  if (u->calls == 2 || u->calls == 3) {
+  if (u->calls == 3 || u->calls == 4) {
     if (jac) {
       jac[0] = INFINITY;
     } else {
