@@ -69,15 +69,18 @@ typedef struct {
   double *val;
 } emitter;
 
-#define EMIT(E, r, c, expr)        \
-  do {                             \
-    if ((E)->pattern) {            \
-      (E)->row[(E)->k] = (r);      \
-      (E)->col[(E)->k] = (c);      \
-    } else if ((E)->val) {         \
-      (E)->val[(E)->k] = (expr);   \
-    }                              \
-    (E)->k++;                      \
+/* mode (a compile-time constant in each instance of emit_body, so the branches fold away:
+ * the value instance runs at every Newton iteration) */
+enum { EMIT_COUNT, EMIT_PATTERN, EMIT_VALUES };
+#define EMIT(E, r, c, expr)            \
+  do {                                 \
+    if (mode == EMIT_PATTERN) {        \
+      (E)->row[(E)->k] = (r);          \
+      (E)->col[(E)->k] = (c);          \
+    } else if (mode == EMIT_VALUES) {  \
+      (E)->val[(E)->k] = (expr);       \
+    }                                  \
+    (E)->k++;                          \
   } while (0)
 
 /* Entries of the indicator Jacobian block of every subsystem: (row, state column, value). */
@@ -90,10 +93,11 @@ typedef struct {
              (scale) * (blkptr)[m->dgoff[kk] + (size_t)cp * nfk + li]);             \
   }
 
-static void emit_jacobian(const fesd__system *S, const double *z, emitter *E) {
+static inline __attribute__((always_inline)) void emit_body(const fesd__system *S, const double *z, emitter *E,
+                                                            const int mode) {
   const int N = S->N, s = S->s, nx = S->nx, nth = S->nth, nsys = S->nsys;
   const fesd__model *m = S->model;
-  const int values = !E->pattern && E->val;
+  const int values = mode == EMIT_VALUES;
   for (int n = 0; n < N; n++) {
     const double h = values ? z[S->ho[n]] : 0;
     for (int j = 0; j < s; j++) {
@@ -196,6 +200,12 @@ static void emit_jacobian(const fesd__system *S, const double *z, emitter *E) {
       }
 }
 
+static void emit_values(const fesd__system *S, const double *z, emitter *E) { emit_body(S, z, E, EMIT_VALUES); }
+static void emit_pattern(const fesd__system *S, emitter *E) {
+  if (E->row) emit_body(S, NULL, E, EMIT_PATTERN);
+  else emit_body(S, NULL, E, EMIT_COUNT);
+}
+
 int fesd__system_init(fesd__system *S, fesd__model *m, const fesd_tableau *tab, int N, int sens) {
   memset(S, 0, sizeof(*S));
   S->model = m;
@@ -262,13 +272,13 @@ int fesd__system_init(fesd__system *S, fesd__model *m, const fesd_tableau *tab, 
     if (fesd__point_alloc(m, &S->pe[p], p < N * s)) goto nomem;
   /* pattern: count, then record */
   emitter E = {0, 0, NULL, NULL, NULL};
-  emit_jacobian(S, NULL, &E);
+  emit_pattern(S, &E);
   S->nnz = E.k;
   S->prow = malloc((size_t)S->nnz * sizeof(int));
   S->pcol = malloc((size_t)S->nnz * sizeof(int));
   if (!S->prow || !S->pcol) goto nomem;
   E = (emitter){0, 1, S->prow, S->pcol, NULL};
-  emit_jacobian(S, NULL, &E);
+  emit_pattern(S, &E);
   return FESD_OK;
 nomem:
   fesd__system_free(S);
@@ -382,7 +392,7 @@ int fesd__system_eval(const double *z, double *raw, double *jac, void *ctx) {
       }
   if (jac) {
     emitter E = {0, 0, NULL, NULL, jac};
-    emit_jacobian(S, z, &E);
+    emit_values(S, z, &E);
   }
   return 0;
 }

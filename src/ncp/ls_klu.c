@@ -8,7 +8,10 @@
  * used to cost a symbolic analysis and a full factorization (measured: 20 % of the
  * oscillator's time with Radau s = 5). The last KLU_CACHE patterns keep their symbolic
  * and numeric objects; a pattern seen again is recognised by comparing it entry by entry
- * (O(nnz), far cheaper than the analysis) and refactorizes in place. */
+ * (O(nnz), far cheaper than the analysis) and refactorizes in place. 8 slots hold every
+ * pattern of the reference problems (ocp-dynamics, Radau s = 5, visits 5 or 6; a second
+ * integration then allocates nothing, tests/fesd/test_alloc.c); memory: up to 8 LU
+ * factors of the step Jacobian. */
 #include "ncp/linsolve.h"
 
 #include "fesd_ncp.h"
@@ -19,7 +22,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define KLU_CACHE 4
+#define KLU_CACHE 8
 
 typedef struct {
   klu_symbolic *symbolic;

@@ -44,8 +44,8 @@ struct fesd_ncp {
   double *vals;       /* assembled Jacobian values */
   double *wgt;        /* n_raw chain-rule weights: 1 for eq/PIN rows, da/db for FB */
 
-  /* iteration buffers (n_raw, nnz, m_max, n) */
-  double *raw_c, *raw_t, *jac_c, *jac_t, *F_c, *F_t;
+  /* iteration buffers (n_raw, nnz, m_max, n); trial points get no Jacobian */
+  double *raw_c, *raw_t, *jac_c, *F_c, *F_t;
   double *zt, *d, *g, *tmp, *z0;
   double *lb, *ub;
   int has_box;

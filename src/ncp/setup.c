@@ -46,7 +46,7 @@ void fesd_ncp_free(fesd_ncp **pws) {
                     ws->pair_pos, ws->fb_list, ws->act_src, ws->act_wrow,  ws->act_tgt,
                     ws->act_r,   ws->act_c,    ws->sp_p,    ws->sp_i,      ws->work,
                     ws->vals,    ws->wgt,      ws->raw_c,   ws->raw_t,     ws->jac_c,
-                    ws->jac_t,   ws->F_c,      ws->F_t,     ws->zt,        ws->d,
+                    ws->F_c,      ws->F_t,     ws->zt,        ws->d,
                     ws->g,       ws->tmp,      ws->z0,      ws->lb,        ws->ub};
   for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++) free(arrays[i]);
   free(ws);
@@ -85,7 +85,6 @@ static int allocate(fesd_ncp *ws) {
   ws->raw_c = alloc(nr, sizeof(double), &fail);
   ws->raw_t = alloc(nr, sizeof(double), &fail);
   ws->jac_c = alloc(nnz, sizeof(double), &fail);
-  ws->jac_t = alloc(nnz, sizeof(double), &fail);
   ws->F_c = alloc(mm, sizeof(double), &fail);
   ws->F_t = alloc(mm, sizeof(double), &fail);
   ws->zt = alloc(n, sizeof(double), &fail);
