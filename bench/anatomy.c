@@ -255,6 +255,38 @@ static void measure(FILE *csv, const fesd_problem *P, const bench_case *c, fesd_
   fflush(stdout);
 }
 
+/* Time per step of the standard method against FESD on the same problem, settings and
+ * solver, measured in alternating rounds (bench_time_pair): the ratio does not depend on
+ * the machine's drift between two separate measurements. */
+static void standard_vs_fesd(FILE *csv, const char *prob, int s, int nsim) {
+  fesd_problem P;
+  fesd_problem_get(prob, &P);
+  fesd_integrator *it[2] = {NULL, NULL};
+  bench_job j[2];
+  int steps[2] = {0, 0};
+  for (int k = 0; k < 2; k++) {
+    fesd_settings set;
+    fesd_settings_default(&set);
+    set.method = k ? FESD_METHOD_STANDARD : FESD_METHOD_FESD;
+    set.stages = s;
+    it[k] = bench_create(&P, &set);
+    j[k] = (bench_job){it[k], &P, nsim, P.T};
+    bench_run r;
+    if (it[k] && !bench_integrate(&j[k], &r)) steps[k] = r.stats.steps;
+  }
+  double tf = NAN, ts = NAN, ratio = NAN;
+  if (steps[0] > 0 && steps[1] > 0) {
+    ratio = bench_time_pair(bench_integrate_fn, &j[0], bench_integrate_fn, &j[1], &tf, &ts);
+    ratio *= (double)steps[0] / steps[1];
+  }
+  const double uf = 1e6 * tf / steps[0], us = 1e6 * ts / steps[1];
+  fprintf(csv, "%s,%d,%d,%d,%d,%.3f,%.3f,%.4f\n", prob, s, nsim, steps[0], steps[1], uf, us, ratio);
+  printf("%-12s s=%d N=%3d: us/step FESD %6.2f standard %6.2f, standard/FESD %.3f (paired rounds)\n", prob, s, nsim,
+         uf, us, ratio);
+  fesd_free(&it[0]);
+  fesd_free(&it[1]);
+}
+
 int main(int argc, char **argv) {
   if (bench_init(argc, argv, "cost anatomy per backend, against one LU + solve")) return 1;
   FILE *csv = bench_csv("anatomy.csv",
@@ -284,6 +316,13 @@ int main(int argc, char **argv) {
     for (int w = 0; w < 2; w++)
       for (int b = 0; b < nb; b++) measure(csv, &P, &cases[c], backends[b], sweeps[w], &mc);
   }
+  fclose(csv);
+  csv = bench_csv("anatomy_pairs.csv", "problem,s,nsim,steps_fesd,steps_std,us_per_step_fesd,us_per_step_std,"
+                                       "ratio_std_to_fesd");
+  if (!csv) return 1;
+  printf("\nstandard time-stepping against FESD per step (same settings, solver and backend auto):\n");
+  for (int c = 0; c < nc; c++)
+    if (cases[c].method == FESD_METHOD_FESD) standard_vs_fesd(csv, cases[c].prob, cases[c].s, cases[c].nsim);
   fclose(csv);
   return 0;
 }

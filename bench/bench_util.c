@@ -56,21 +56,43 @@ double bench_median(double *v, int n) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
+/* CPU seconds per call of fn over >= t_min seconds (negative if fn fails) */
+static double time_calls(bench_fn fn, void *ctx, double t_min) {
+  long count = 0;
+  double t0 = bench_cpu(), el;
+  do {
+    if (fn(ctx)) return -1.0;
+    count++;
+    el = bench_cpu() - t0;
+  } while (el < t_min);
+  return el / (double)count;
+}
+
 double bench_time(bench_fn fn, void *ctx) {
   double per[16];
   int reps = bench_opt.reps > 16 ? 16 : bench_opt.reps;
   if (fn(ctx)) return NAN; /* warm-up: first-touch of workspaces, caches */
-  for (int r = 0; r < reps; r++) {
-    long count = 0;
-    double t0 = bench_cpu(), el;
-    do {
-      if (fn(ctx)) return NAN;
-      count++;
-      el = bench_cpu() - t0;
-    } while (el < bench_opt.min_time);
-    per[r] = el / (double)count;
-  }
+  for (int r = 0; r < reps; r++)
+    if ((per[r] = time_calls(fn, ctx, bench_opt.min_time)) < 0) return NAN;
   return bench_median(per, reps);
+}
+
+double bench_time_pair(bench_fn a, void *ca, bench_fn b, void *cb, double *ta, double *tb) {
+  enum { MAX_ROUNDS = 33 };
+  double va[MAX_ROUNDS], vb[MAX_ROUNDS], ratio[MAX_ROUNDS];
+  int rounds = 2 * bench_opt.reps + 1;
+  if (rounds > MAX_ROUNDS) rounds = MAX_ROUNDS;
+  *ta = *tb = NAN;
+  if (a(ca) || b(cb)) return NAN; /* warm-up */
+  for (int r = 0; r < rounds; r++) {
+    va[r] = time_calls(a, ca, 0.25 * bench_opt.min_time);
+    vb[r] = time_calls(b, cb, 0.25 * bench_opt.min_time);
+    if (va[r] < 0 || vb[r] < 0) return NAN;
+    ratio[r] = vb[r] / va[r];
+  }
+  *ta = bench_median(va, rounds);
+  *tb = bench_median(vb, rounds);
+  return bench_median(ratio, rounds);
 }
 
 int bench_integrate(const bench_job *j, bench_run *r) {

@@ -32,6 +32,11 @@ double bench_cpu(void);
 typedef int (*bench_fn)(void *ctx);
 double bench_time(bench_fn fn, void *ctx);
 double bench_median(double *v, int n); /* sorts v */
+/* Paired timing of two functions, for ratios that must not depend on when each was
+ * measured (the machine's speed drifts by tens of percent over seconds): rounds alternate
+ * a and b (each for >= min_time / 4 CPU seconds); returns the median over the rounds of
+ * time(b) / time(a), and the median times per call in *ta, *tb. NaN if a call fails. */
+double bench_time_pair(bench_fn a, void *ca, bench_fn b, void *cb, double *ta, double *tb);
 
 /* One integration: nsim steps of T / nsim from P->x0 with P->u. */
 typedef struct {

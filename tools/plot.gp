@@ -109,8 +109,9 @@ unset multiplot
 # ---- 6. cost anatomy ----
 f = dir."/anatomy.csv"
 set output dir."/anatomy.png"
-set terminal pngcairo size 1400,650 font ",10"
-set title "Share of the time of one integration (anatomy.csv); label: problem method s N_{sim} backend"
+set terminal pngcairo size 1900,700 font ",10"
+set rmargin 10
+set title "Share of the time of one integration (anatomy.csv); label: problem method s N_{sim} max\\_sweeps backend"
 unset xlabel
 set ylabel "share of wall time"
 set yrange [0:1]
@@ -122,7 +123,7 @@ set xtics rotate by -40 font ",8"
 set key outside right
 unset grid
 set grid ytics
-lab(a) = sprintf("%s %s s%d N%d %s", strcol("problem"), strcol("method"), column("s"), column("nsim"), strcol("backend"))
+lab(a) = sprintf("%s %s s%d N%d sw%d %s", strcol("problem"), strcol("method"), column("s"), column("nsim"), column("max_sweeps"), strcol("backend"))
 plot f using "share_eval":xtic(lab(0)) lc rgb word(cols,1) title "residual + Jacobian", \
      '' using "share_linsolve" lc rgb word(cols,2) title "factorize + solve", \
      '' using "share_solver_other" lc rgb word(cols,3) title "rest of the solver", \

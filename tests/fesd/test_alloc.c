@@ -13,40 +13,14 @@
 #include "fesd.h"
 #include "problems/problems.h"
 
-#if defined(__SANITIZE_ADDRESS__)
-#define UNDER_ASAN 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define UNDER_ASAN 1
-#endif
-#endif
+#include "../alloc_hook.h"
 
-#ifdef UNDER_ASAN
+#if !ALLOC_HOOK_ACTIVE
 int main(void) {
   printf("skipped under AddressSanitizer\n");
   return 77;
 }
 #else
-void *__libc_malloc(size_t n);
-void *__libc_calloc(size_t n, size_t size);
-void *__libc_realloc(void *p, size_t n);
-void __libc_free(void *p);
-static long g_count = 0;
-#define EXPORT __attribute__((visibility("default")))
-EXPORT void *malloc(size_t n) {
-  g_count++;
-  return __libc_malloc(n);
-}
-EXPORT void *calloc(size_t n, size_t size) {
-  g_count++;
-  return __libc_calloc(n, size);
-}
-EXPORT void *realloc(void *p, size_t n) {
-  g_count++;
-  return __libc_realloc(p, n);
-}
-EXPORT void free(void *p) { __libc_free(p); }
-
 /* allocations during set_state + nsim steps (of the last of `passes` integrations on one
  * integrator); per-step counts in per_step (may be NULL) */
 static long count_run(const char *name, fesd_ncp_backend bk, int s, int nsim, int passes, long *per_step) {
