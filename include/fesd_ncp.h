@@ -145,8 +145,11 @@ typedef struct fesd_ncp fesd_ncp; /**< opaque workspace */
 FESD_API int fesd_ncp_settings_default(fesd_ncp_settings *s);
 
 /**
- * @brief Validate the problem and settings, copy the pattern, allocate the workspace,
- *        choose the backend and do the symbolic analysis (all rows active, all pairs FB).
+ * @brief Validate the problem and settings, copy the pattern, allocate the workspace and
+ *        choose the backend. The default row selection (all rows active, all pairs FB) is
+ *        analysed at its first use (a solve, residual or sensitivity before any
+ *        fesd_ncp_set_rows), so a caller that selects its own rows first never pays for it;
+ *        failures of that analysis (FESD_ERR_NOMEM, FESD_ERR_LINSOLVE) are returned there.
  * @param[out] ws  new workspace (NULL on error; nothing leaks)
  * @param[in]  p   problem (not modified)
  * @param[in]  s   settings, or NULL for defaults

@@ -24,6 +24,7 @@ struct fesd_ncp {
   fesd__ls *lu, *normal;
   fesd__ls *active; /* the one used by the current row selection */
   int ready;        /* 0 after a failed re-analysis: solves return FESD_ERR_NOT_READY */
+  int rows_pending; /* the selection is set but not applied yet (setup): applied at first use */
 
   /* row selection */
   unsigned char *eq_on, *pair_mode;
@@ -64,6 +65,8 @@ int fesd__all_finite(const double *x, int n);
 
 /* rows.c */
 int fesd__ncp_apply_rows(fesd_ncp *ws);
+/* Apply a pending selection (FESD_OK when ready, FESD_ERR_NOT_READY after a failed one). */
+int fesd__ncp_ensure_rows(fesd_ncp *ws);
 
 /* newton.c: callback wrapper shared with sensitivity.c */
 int fesd__ncp_call(fesd_ncp *ws, const double *z, double *raw, double *jac, fesd__ncp_stats *st);

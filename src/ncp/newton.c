@@ -333,7 +333,8 @@ static int begin(fesd_ncp *ws, double *z, double sigma, fesd_ncp_info *info,
   memset(info, 0, sizeof *info);
   if (!ws || !z) return FESD_ERR_NULL;
   if (!(sigma >= 0.0) || !isfinite(sigma)) return FESD_ERR_INVALID_ARG;
-  if (!ws->ready) return FESD_ERR_NOT_READY;
+  int rc = fesd__ncp_ensure_rows(ws);
+  if (rc != FESD_OK) return rc;
   *st = ws->pending;
   memset(&ws->pending, 0, sizeof ws->pending);
   project(ws, z);
@@ -398,7 +399,8 @@ int fesd_ncp_solve_homotopy(fesd_ncp *ws, double *z, fesd_ncp_info *info) {
 int fesd_ncp_residual(fesd_ncp *ws, const double *z, double sigma, double *F, double *norm_inf_out) {
   if (!ws || !z) return FESD_ERR_NULL;
   if (!(sigma >= 0.0) || !isfinite(sigma)) return FESD_ERR_INVALID_ARG;
-  if (!ws->ready) return FESD_ERR_NOT_READY;
+  int rc0 = fesd__ncp_ensure_rows(ws);
+  if (rc0 != FESD_OK) return rc0;
   fesd__ncp_stats st;
   memset(&st, 0, sizeof st);
   int rc = fesd__ncp_call(ws, z, ws->raw_t, NULL, &st);

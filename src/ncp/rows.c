@@ -63,6 +63,14 @@ static int assembled_row(const fesd_ncp *ws, const int *eq_pos, int rr) {
   }
 }
 
+int fesd__ncp_ensure_rows(fesd_ncp *ws) {
+  if (ws->rows_pending) {
+    ws->rows_pending = 0;
+    return fesd__ncp_apply_rows(ws);
+  }
+  return ws->ready ? FESD_OK : FESD_ERR_NOT_READY;
+}
+
 int fesd__ncp_apply_rows(fesd_ncp *ws) {
   const int n = ws->n, n_eq = ws->n_eq, np = ws->n_pair;
   int *eq_pos = ws->work; /* scratch, consumed before build_csc reuses work */

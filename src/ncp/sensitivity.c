@@ -30,7 +30,8 @@ int fesd_ncp_sensitivity(fesd_ncp *ws, const double *z, double sigma, int nrhs,
   if (!ws || !z) return FESD_ERR_NULL;
   if (nrhs < 0 || !(sigma >= 0.0) || !isfinite(sigma)) return FESD_ERR_INVALID_ARG;
   if (nrhs > 0 && (!draw_dp || !dz_dp)) return FESD_ERR_NULL;
-  if (!ws->ready) return FESD_ERR_NOT_READY;
+  int rc_rows = fesd__ncp_ensure_rows(ws);
+  if (rc_rows != FESD_OK) return rc_rows;
   if (nrhs == 0) return FESD_OK;
 
   fesd__ncp_stats *st = &ws->pending;
