@@ -172,8 +172,36 @@ static void check_solves(void) {
   lcp_free(&p.lcp);
 }
 
+/* The default selection is analysed at its first use: a rejected selection while it is
+ * still pending leaves it in force, and the first residual applies it (all rows, FB). */
+static void check_deferred_default(void) {
+  printf("Default selection analysed at first use\n");
+  const int row[7] = {0, 1, 2, 3, 4, 5, 6}, col[7] = {0, 0, 0, 1, 1, 2, 2};
+  fesd_ncp_problem p = {3, 3, 2, 7, row, col, order_eval, NULL};
+  const int backends[] = {FESD_NCP_BACKEND_DENSE, FESD_NCP_BACKEND_KLU, FESD_NCP_BACKEND_CHOLMOD};
+  for (int b = 0; b < 3; b++) {
+    fesd_ncp_settings s;
+    fesd_ncp_settings_default(&s);
+    s.backend = backends[b];
+    fesd_ncp *ws = NULL;
+    CHECK_RC(fesd_ncp_setup(&ws, &p, &s), FESD_OK);
+    const unsigned char eq0[3] = {0, 0, 0}, pm0[2] = {FESD_NCP_PAIR_OFF, FESD_NCP_PAIR_FB};
+    CHECK_RC(fesd_ncp_set_rows(ws, eq0, pm0), FESD_ERR_DIMENSION);
+    CHECK(fesd_ncp_rows(ws) == 5, "%s: default m = 5 kept, got %d", fesd_ncp_backend_name(backends[b]),
+          fesd_ncp_rows(ws));
+    const double z[3] = {0.5, 2.0, 3.0};
+    double F[7];
+    CHECK_RC(fesd_ncp_residual(ws, z, 0.0, F, NULL), FESD_OK);
+    double want[5] = {10.5, 20.5, 30.5, fesd_fb(2.0, 3.0, 0.0, NULL, NULL), fesd_fb(3.0, 2.0, 0.0, NULL, NULL)};
+    CHECK(vec_dist_inf(F, want, 5) == 0.0, "%s: default rows (3 eq, 2 FB) at first use",
+          fesd_ncp_backend_name(backends[b]));
+    fesd_ncp_free(&ws);
+  }
+}
+
 int main(void) {
   check_order();
+  check_deferred_default();
   check_solves();
   return test_summary("test_ncp_rows");
 }
