@@ -64,7 +64,7 @@ double fesd__cross_value(const fesd__system *S, const double *z, int n) {
 /* ---- Jacobian emission: one traversal counts the entries, writes the pattern, or writes
  *      the values, so all three always agree. ---- */
 typedef struct {
-  int k, pattern; /* pattern: 1 = write (row, col); 0 = write values (val) or count (val NULL) */
+  int k; /* entries emitted so far */
   int *row, *col;
   double *val;
 } emitter;
@@ -200,10 +200,18 @@ static inline __attribute__((always_inline)) void emit_body(const fesd__system *
       }
 }
 
-static void emit_values(const fesd__system *S, const double *z, emitter *E) { emit_body(S, z, E, EMIT_VALUES); }
-static void emit_pattern(const fesd__system *S, emitter *E) {
-  if (E->row) emit_body(S, NULL, E, EMIT_PATTERN);
-  else emit_body(S, NULL, E, EMIT_COUNT);
+static int emit_count(const fesd__system *S) {
+  emitter E = {0, NULL, NULL, NULL};
+  emit_body(S, NULL, &E, EMIT_COUNT);
+  return E.k;
+}
+static void emit_pattern(const fesd__system *S, int *row, int *col) {
+  emitter E = {0, row, col, NULL};
+  emit_body(S, NULL, &E, EMIT_PATTERN);
+}
+static void emit_values(const fesd__system *S, const double *z, double *val) {
+  emitter E = {0, NULL, NULL, val};
+  emit_body(S, z, &E, EMIT_VALUES);
 }
 
 int fesd__system_init(fesd__system *S, fesd__model *m, const fesd_tableau *tab, int N, int sens) {
@@ -271,14 +279,11 @@ int fesd__system_init(fesd__system *S, fesd__model *m, const fesd_tableau *tab, 
   for (int p = 0; p < np; p++)
     if (fesd__point_alloc(m, &S->pe[p], p < N * s)) goto nomem;
   /* pattern: count, then record */
-  emitter E = {0, 0, NULL, NULL, NULL};
-  emit_pattern(S, &E);
-  S->nnz = E.k;
+  S->nnz = emit_count(S);
   S->prow = malloc((size_t)S->nnz * sizeof(int));
   S->pcol = malloc((size_t)S->nnz * sizeof(int));
   if (!S->prow || !S->pcol) goto nomem;
-  E = (emitter){0, 1, S->prow, S->pcol, NULL};
-  emit_pattern(S, &E);
+  emit_pattern(S, S->prow, S->pcol);
   return FESD_OK;
 nomem:
   fesd__system_free(S);
@@ -390,10 +395,7 @@ int fesd__system_eval(const double *z, double *raw, double *jac, void *ctx) {
         raw[S->n_eq + p] = z[fesd__th(S, n, j) + i];
         raw[S->n_eq + S->n_pair + p] = z[fesd__la(S, n, j) + i];
       }
-  if (jac) {
-    emitter E = {0, 0, NULL, NULL, jac};
-    emit_values(S, z, &E);
-  }
+  if (jac) emit_values(S, z, jac);
   return 0;
 }
 
