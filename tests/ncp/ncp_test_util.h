@@ -51,6 +51,14 @@ static inline double rng_uniform(rng_t *r) {
 }
 static inline double rng_sym(rng_t *r) { return 2.0 * rng_uniform(r) - 1.0; }
 
+/* fesd_ncp_setup with default settings and the given backend. */
+static inline int setup_backend(fesd_ncp **ws, const fesd_ncp_problem *p, int backend) {
+  fesd_ncp_settings s;
+  fesd_ncp_settings_default(&s);
+  s.backend = (fesd_ncp_backend)backend;
+  return fesd_ncp_setup(ws, p, &s);
+}
+
 static inline double vec_dist_inf(const double *a, const double *b, int n) {
   double d = 0.0;
   for (int i = 0; i < n; i++) d = fmax(d, fabs(a[i] - b[i]));

@@ -220,11 +220,8 @@ static void public_conformance(void) {
   fesd_ncp_problem p = {NB, NEB, NB - NEB, u.nnz, u.row, u.col, mcp_eval, &u};
   const int backends[3] = {FESD_NCP_BACKEND_DENSE, FESD_NCP_BACKEND_UMFPACK, FESD_NCP_BACKEND_KLU};
   for (int b = 0; b < 3; b++) {
-    fesd_ncp_settings s;
-    fesd_ncp_settings_default(&s);
-    s.backend = backends[b];
     fesd_ncp *ws = NULL;
-    CHECK_RC(fesd_ncp_setup(&ws, &p, &s), FESD_OK);
+    CHECK_RC(setup_backend(&ws, &p, backends[b]), FESD_OK);
     for (int i = 0; i < NB; i++) z[i] = 0.5;
     fesd_ncp_info info;
     int rc = fesd_ncp_solve(ws, z, 0.0, &info);

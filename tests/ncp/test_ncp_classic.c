@@ -155,11 +155,8 @@ static fesd_ncp *make_ws(const ncp_def *def, ncp_user *u, int backend) {
   u->def = def;
   u->calls = 0;
   fesd_ncp_problem p = {n, 0, n, nnz, row, col, ncp_eval, u};
-  fesd_ncp_settings s;
-  fesd_ncp_settings_default(&s);
-  s.backend = backend;
   fesd_ncp *ws = NULL;
-  CHECK_RC(fesd_ncp_setup(&ws, &p, &s), FESD_OK);
+  CHECK_RC(setup_backend(&ws, &p, backend), FESD_OK);
   free(row);
   free(col);
   return ws;

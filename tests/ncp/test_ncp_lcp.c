@@ -12,11 +12,8 @@ static const int backends[] = {FESD_NCP_BACKEND_DENSE, FESD_NCP_BACKEND_UMFPACK,
 static int solve_lcp(lcp_t *lcp, int backend, const double *zref, int check_quadratic,
                      double *zout) {
   fesd_ncp_problem p = lcp_problem(lcp);
-  fesd_ncp_settings s;
-  fesd_ncp_settings_default(&s);
-  s.backend = backend;
   fesd_ncp *ws = NULL;
-  CHECK_RC(fesd_ncp_setup(&ws, &p, &s), FESD_OK);
+  CHECK_RC(setup_backend(&ws, &p, backend), FESD_OK);
   if (!ws) return -1;
   int n = lcp->n;
   double *z = malloc((size_t)n * sizeof(double));

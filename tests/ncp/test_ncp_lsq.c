@@ -68,11 +68,8 @@ static void lsq_free(lsq_t *p) {
 static int solve_lsq(lsq_t *p, int backend, int want_rc, const double *zs) {
   int n = p->lcp->n;
   fesd_ncp_problem pr = {n, p->n_eq, n, p->nnz, p->row, p->col, lsq_eval, p};
-  fesd_ncp_settings s;
-  fesd_ncp_settings_default(&s);
-  s.backend = backend;
   fesd_ncp *ws = NULL;
-  CHECK_RC(fesd_ncp_setup(&ws, &pr, &s), FESD_OK);
+  CHECK_RC(setup_backend(&ws, &pr, backend), FESD_OK);
   if (!ws) return -1;
   double *z = malloc((size_t)n * sizeof(double));
   for (int i = 0; i < n; i++) z[i] = 1.0;

@@ -83,11 +83,8 @@ static void solve_sel(rows_t *p, int backend, const unsigned char *eq, const uns
                       int want_m, int want_backend, const char *what) {
   int n = p->lcp.n;
   fesd_ncp_problem pr = {n, 2, n, p->nnz, p->row, p->col, rows_eval, p};
-  fesd_ncp_settings s;
-  fesd_ncp_settings_default(&s);
-  s.backend = backend;
   fesd_ncp *ws = NULL;
-  CHECK_RC(fesd_ncp_setup(&ws, &pr, &s), FESD_OK);
+  CHECK_RC(setup_backend(&ws, &pr, backend), FESD_OK);
   if (!ws) return;
   double *z = malloc((size_t)n * sizeof(double));
   /* the same workspace goes through several selections (re-analysis when sparse) */
@@ -180,11 +177,8 @@ static void check_deferred_default(void) {
   fesd_ncp_problem p = {3, 3, 2, 7, row, col, order_eval, NULL};
   const int backends[] = {FESD_NCP_BACKEND_DENSE, FESD_NCP_BACKEND_KLU, FESD_NCP_BACKEND_CHOLMOD};
   for (int b = 0; b < 3; b++) {
-    fesd_ncp_settings s;
-    fesd_ncp_settings_default(&s);
-    s.backend = backends[b];
     fesd_ncp *ws = NULL;
-    CHECK_RC(fesd_ncp_setup(&ws, &p, &s), FESD_OK);
+    CHECK_RC(setup_backend(&ws, &p, backends[b]), FESD_OK);
     const unsigned char eq0[3] = {0, 0, 0}, pm0[2] = {FESD_NCP_PAIR_OFF, FESD_NCP_PAIR_FB};
     CHECK_RC(fesd_ncp_set_rows(ws, eq0, pm0), FESD_ERR_DIMENSION);
     CHECK(fesd_ncp_rows(ws) == 5, "%s: default m = 5 kept, got %d", fesd_ncp_backend_name(backends[b]),

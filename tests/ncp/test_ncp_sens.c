@@ -140,11 +140,8 @@ int main(void) {
                            FESD_NCP_BACKEND_CHOLMOD};
   printf("Sensitivities (n = %d, %d equations, %d pairs, 2 parameters)\n", N, NE, NP);
   for (int b = 0; b < 4; b++) {
-    fesd_ncp_settings set;
-    fesd_ncp_settings_default(&set);
-    set.backend = backends[b];
     fesd_ncp *ws = NULL;
-    CHECK_RC(fesd_ncp_setup(&ws, &p, &set), FESD_OK);
+    CHECK_RC(setup_backend(&ws, &p, backends[b]), FESD_OK);
     if (!ws) continue;
     char what[64];
     if (backends[b] != FESD_NCP_BACKEND_CHOLMOD) {
