@@ -110,6 +110,12 @@ typedef struct {
   int max_sweeps;           /**< fixed-point sweeps that make the initial guess of a step
                                  consistent (default 8, at least 1; they stop early when
                                  converged or slow, and cost no Jacobian) */
+  int max_elements;         /**< most elements of one solve (FESD): a step that holds k
+                                 switches gets max(n_fe, k + 1) elements (one boundary per
+                                 switch); one that holds more than max_elements - 1 is solved
+                                 in sub-steps that end between two switches. Default 32, range
+                                 [n_fe, 4096]; memory grows with it (step data of that many
+                                 elements) */
   fesd_ncp_settings ncp;    /**< linear algebra/line-search settings of the solver */
 } fesd_settings;
 
@@ -128,6 +134,12 @@ typedef struct {
   unsigned after;        /**< active modes after */
 } fesd_event;
 
+/** Flags of a step (fesd_step_info.flags, counted in fesd_stats.flagged): the result was
+ *  accepted, and this is what the user should know about it. */
+#define FESD_FLAG_NONUNIQUE 0x1 /**< the step started on a switching surface that the fields on
+                                     both sides leave: the Filippov solution is not unique (the one
+                                     returned stays on the surface) */
+
 /** Statistics of one fesd_step() (accumulated over sub-steps when it splits). */
 typedef struct {
   int status;           /**< FESD_OK or a negative fesd_status */
@@ -135,7 +147,10 @@ typedef struct {
   int factorizations;
   int solves;           /**< calls of the NCP solver */
   int homotopy_stages;
-  int splits;           /**< sub-steps added by recovery (0 = none) */
+  int splits;           /**< sub-steps added by recovery: halvings of a failed (sub)step */
+  int substeps;         /**< sub-steps added because the step held more switches than
+                             settings.max_elements - 1 */
+  int flags;            /**< FESD_FLAG_* bits */
   int switch_step;      /**< 1 if the accepted solution needed a switch solve */
   int fallback;         /**< sub-steps solved by the FB fallback path (active-set path failed) */
   double residual;      /**< final ||F||_inf of the accepted system */
@@ -212,6 +227,8 @@ FESD_API int fesd_dense_output(const fesd_integrator *it, double t, double *x);
 typedef struct {
   int steps, switch_steps, newton_iter, factorizations, solves, homotopy_stages, splits;
   int fallback_steps;      /**< steps (or sub-steps) solved by the FB fallback path */
+  int substeps;            /**< sub-steps of steps that held many switches */
+  int nonunique_steps;     /**< steps flagged FESD_FLAG_NONUNIQUE */
   int events;
   double time;             /**< wall-clock seconds in fesd_step */
   double max_iter_ordinary_step; /**< max Newton iterations of a step without switch */

@@ -1,6 +1,7 @@
 /* Acceptance of a converged step: sensitivities by the implicit function theorem,
  * element records, event classification and the state update. */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "fesd/step.h"
@@ -45,15 +46,13 @@ int fesd__update_lambda00(fesd_integrator *it, const double *x, const double *u,
   return FESD_OK;
 }
 
-/* dx_end/d(x_start, u) of the accepted step by the implicit function theorem, chained into
- * Sx, Su. */
-/* Saltation at a crossing or sliding entry that falls exactly on the step start (the
- * previous step ended on the surface): S <- (I + (f+ - f-) grad psi' / (grad psi' f-)) S,
+/* Saltation at a crossing or sliding entry of subsystem k that falls exactly on the step start
+ * (the previous step ended on the surface): S <- (I + (f+ - f-) grad psi' / (grad psi' f-)) S,
  * psi = g_in - g_out, f- = F theta_prev, f+ = F theta of the first stage (paper Prop. 4);
  * for u also the direct dependence of psi on u. */
-static int start_jump(fesd_integrator *it, const double *z) {
+static int start_jump(fesd_integrator *it, const double *z, int k) {
   fesd__model *m = &it->model;
-  const int nx = m->nx, nu = m->nu, nth = m->nth, a = it->jump_in, b = it->jump_out;
+  const int nx = m->nx, nu = m->nu, nth = m->nth, a = it->jump_in[k], b = it->jump_out[k];
   fesd__point_eval pe = {0};
   pe.F = it->pscr.F;
   pe.g = it->pscr.g;
@@ -64,10 +63,8 @@ static int start_jump(fesd_integrator *it, const double *z) {
   const double *th1 = z + fesd__th(&it->sys, 0, 0);
   double *df = it->vtmp, *fm = it->vtmp + nx; /* f+ - f-, f- */
   memset(df, 0, 2 * (size_t)nx * sizeof(double));
-  for (int i = 0; i < nth; i++) {
-    fesd__F_axpy(m, &pe, i, th1[i] - it->theta_prev[i], df);
-    fesd__F_axpy(m, &pe, i, it->theta_prev[i], fm);
-  }
+  for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) fesd__F_axpy(m, &pe, i, th1[i] - it->theta_prev[i], df);
+  for (int i = 0; i < nth; i++) fesd__F_axpy(m, &pe, i, it->theta_prev[i], fm);
   double den = fesd__dg_dot(m, &pe, a, fm) - fesd__dg_dot(m, &pe, b, fm);
   if (fabs(den) < 1e-300) return FESD_OK; /* grazing: no transversal saltation */
   /* S <- S + df (grad psi' S) / den, column by column */
@@ -80,29 +77,33 @@ static int start_jump(fesd_integrator *it, const double *z) {
   return FESD_OK;
 }
 
+/* dx_end/d(x_start, u) of the accepted step by the implicit function theorem on the rows of
+ * the last solve (the binding rows of the accepted solution), chained into Sx, Su. */
 static int chain_sensitivities(fesd_integrator *it, const double *z) {
-  if (it->jump_in >= 0) {
-    int sj = start_jump(it, z);
-    if (sj) return sj;
-  }
+  for (int k = 0; k < it->nsys; k++)
+    if (it->jump_in[k] >= 0) {
+      int sj = start_jump(it, z, k);
+      if (sj) return sj;
+    }
   fesd__system *S = &it->sys;
+  fesd__level *L = &it->lv[it->lv_cur];
   const int nx = it->nx, nu = it->nu, np = nx + nu;
   S->want_u = 1;
-  int st = fesd__system_eval(z, it->raw, it->jac, S);
+  int st = fesd__system_eval(z, it->raw, L->jac, S);
   if (st) {
     S->want_u = 0;
     return S->status ? S->status : FESD_ERR_CALLBACK;
   }
-  fesd__system_param_jac(S, z, it->draw);
+  fesd__system_param_jac(S, z, L->draw);
   S->want_u = 0;
-  st = fesd_ncp_sensitivity(it->ncp, z, 0.0, np, it->draw, it->dz);
+  st = fesd_ncp_sensitivity(it->ncp, z, 0.0, np, L->draw, L->dz);
   if (st == FESD_ERR_CALLBACK && S->status) st = S->status; /* the model's own status */
   if (st) return st;
   /* D = rows of x_N in dz: nx x np */
   const int xN = S->xo[S->N - 1];
   double *D = it->Dtmp;
   for (int c = 0; c < np; c++)
-    for (int r = 0; r < nx; r++) D[c * nx + r] = it->dz[(size_t)c * S->n + xN + r];
+    for (int r = 0; r < nx; r++) D[c * nx + r] = L->dz[(size_t)c * S->n + xN + r];
   /* Sx <- Dx Sx ; Su <- Dx Su + Du */
   double *T = it->Stmp;
   for (int c = 0; c < nx; c++)
@@ -152,14 +153,34 @@ static void add_event(fesd_integrator *it, double t, int k, unsigned before, uns
     e->kind = FESD_EVENT_CROSSING;
 }
 
+/* Element records for need elements (doubling; outside the Newton loop: a step with more
+ * sub-steps or switches than any before). */
+int fesd__grow_records(fesd_integrator *it, int need) {
+  if (need <= it->cap_el) return FESD_OK;
+  int cap = it->cap_el > 0 ? it->cap_el : 8;
+  while (cap < need) cap *= 2;
+  const size_t c = (size_t)cap, nx = (size_t)it->nx, nth = (size_t)it->nth, s = (size_t)it->s;
+  double **arr[] = {&it->rec_h, &it->rec_t, &it->rec_x, &it->rec_th, &it->rec_la, &it->rec_mu, &it->rec_v};
+  const size_t len[] = {c, c + 1, (c + 1) * nx, c * s * nth, c * s * nth, c * s * (size_t)it->nsys, c * s * nx};
+  for (int a = 0; a < 7; a++) {
+    double *p = realloc(*arr[a], (len[a] > 0 ? len[a] : 1) * sizeof(double));
+    if (!p) return FESD_ERR_NOMEM; /* the arrays grown so far stay valid */
+    *arr[a] = p;
+  }
+  it->cap_el = cap;
+  return FESD_OK;
+}
+
 int fesd__accept(fesd_integrator *it, const double *z, const double *u, double T) {
   fesd__system *S = &it->sys;
   const int N = S->N, s = S->s, nx = it->nx, nth = it->nth, nsys = it->nsys;
   int st;
+  if ((st = fesd__grow_records(it, it->n_el + N))) return st;
+  fesd__system_update_refs(S); /* the sizes of the last weighting: at z (step.c, solve) */
   if (it->set.sensitivities && (st = chain_sensitivities(it, z))) return st;
   /* records */
   double t = it->t;
-  for (int n = 0; n < N && it->n_el < it->cap_el; n++) {
+  for (int n = 0; n < N; n++) {
     int e = it->n_el++;
     it->rec_h[e] = z[S->ho[n]];
     it->rec_t[e] = t;
@@ -193,7 +214,7 @@ int fesd__accept(fesd_integrator *it, const double *z, const double *u, double T
   memcpy(it->theta_prev, z + fesd__th(S, N - 1, s - 1), (size_t)nth * sizeof(double));
   it->have_prev_theta = 1;
   if ((st = fesd__update_lambda00(it, it->x, u, it->set.sensitivities))) return st;
-  memcpy(it->zws, z, (size_t)S->n * sizeof(double));
+  memcpy(it->ws_blk, z + fesd__v(S, N - 1, s - 1), (size_t)S->sb * sizeof(double));
   it->have_ws = 1;
   return FESD_OK;
 }

@@ -145,7 +145,7 @@ static int lp_block(fesd_integrator *it, const double *x, const double *u, doubl
 int fesd__initial_guess(fesd_integrator *it, const double *u, double T, double *z) {
   fesd__system *S = &it->sys;
   if (it->have_ws) {
-    memcpy(it->blk, it->zws + fesd__v(S, S->N - 1, S->s - 1), (size_t)S->sb * sizeof(double));
+    memcpy(it->blk, it->ws_blk, (size_t)S->sb * sizeof(double));
   } else {
     int st = lp_block(it, it->x, u, it->blk);
     if (st) return st;
@@ -157,3 +157,77 @@ int fesd__initial_guess(fesd_integrator *it, const double *u, double T, double *
   return fesd__consistent_guess(it, z);
 }
 
+
+/* theta of the stage for the active flags a at the evaluated point pe: the indicator of a
+ * single mode; for a 2-mode sliding mode Filippov's multiplier (the convex combination
+ * tangent to the surface, other subsystems at th), else uniform weights. */
+static void stage_theta(fesd_integrator *it, const fesd__point_eval *pe, const unsigned char *a,
+                        double *th) {
+  const fesd__model *m = &it->model;
+  for (int k = 0; k < m->nsys; k++) {
+    int cnt = 0;
+    for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) cnt += a[i];
+    for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) th[i] = a[i] ? 1.0 / cnt : 0.0;
+  }
+  for (int k = 0; k < m->nsys; k++) {
+    int i = -1, j = -1, cnt = 0;
+    for (int l = m->th_off[k]; l < m->th_off[k + 1]; l++)
+      if (a[l]) {
+        if (cnt++ == 0) i = l;
+        else j = l;
+      }
+    if (cnt != 2) continue;
+    double ai, aj;
+    fesd__normal_components(it, pe, th, i, j, &ai, &aj);
+    if (ai > 0 && aj < 0) { /* a sliding mode at this point */
+      th[i] = -aj / (ai - aj);
+      th[j] = ai / (ai - aj);
+    }
+  }
+}
+
+/* LP values of a stage block at the evaluated point: mu the theta-weighted indicator (so the
+ * modes theta marks active get lambda = 0 on the surface), lambda = g - mu. */
+static void stage_lp(const fesd__model *m, const double *g, const double *th, double *la, double *mu) {
+  for (int k = 0; k < m->nsys; k++) {
+    double num = 0, den = 0;
+    for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) num += th[i] * g[i], den += th[i];
+    mu[k] = den > 0 ? num / den : g[m->th_off[k]];
+  }
+  for (int i = 0; i < m->nth; i++) la[i] = g[i] - mu[m->sys_of[i]];
+}
+
+int fesd__regrid_guess(fesd_integrator *it, const double *zp, int Np, double *z) {
+  fesd__system *S = &it->sys;
+  fesd__model *m = &it->model;
+  const int nx = S->nx, nth = S->nth, s = S->s;
+  double *X = S->X; /* scratch: one state */
+  fesd__point_eval pe = {0};
+  pe.F = it->pscr.F;
+  pe.g = it->pscr.g;
+  pe.dgdx = it->pscr.dgdx;
+  double tn = 0;
+  for (int n = 0; n < S->N; n++) {
+    const double h = z[S->ho[n]];
+    for (int j = 0; j < s; j++) {
+      fesd__state_at(it, zp, Np, tn + S->tab.c[j] * h, X);
+      int st = fesd__model_eval(m, X, S->u, &pe);
+      if (st) return st;
+      double *v = z + fesd__v(S, n, j), *th = z + fesd__th(S, n, j);
+      stage_theta(it, &pe, it->act + (size_t)(n * s + j) * nth, th);
+      memset(v, 0, (size_t)nx * sizeof(double));
+      for (int i = 0; i < nth; i++)
+        if (th[i] != 0.0) fesd__F_axpy(m, &pe, i, th[i], v);
+      stage_lp(m, pe.g, th, z + fesd__la(S, n, j), z + fesd__mu(S, n, j));
+    }
+    tn += h;
+    fesd__state_at(it, zp, Np, tn, z + S->xo[n]);
+    if (S->bp) {
+      int st = fesd__model_g(m, z + S->xo[n], S->u, pe.g);
+      if (st) return st;
+      double *LB = z + S->lbo[n];
+      stage_lp(m, pe.g, z + fesd__th(S, n, s - 1), LB, LB + nth);
+    }
+  }
+  return FESD_OK;
+}

@@ -23,6 +23,7 @@ int fesd_settings_default(fesd_settings *s) {
   s->max_splits = 6;
   s->sensitivities = 0;
   s->max_sweeps = 8;
+  s->max_elements = 32;
   fesd_ncp_settings_default(&s->ncp);
   return FESD_OK;
 }
@@ -35,38 +36,90 @@ static int validate_settings(const fesd_settings *s) {
   if (s->max_iter_first < 1 || s->max_iter < 1) return FESD_ERR_INVALID_ARG;
   if (s->max_splits < 0 || s->max_splits > 12) return FESD_ERR_INVALID_ARG;
   if (s->max_sweeps < 1 || s->max_sweeps > 50) return FESD_ERR_INVALID_ARG;
+  if (s->max_elements < s->n_fe || s->max_elements > 4096) return FESD_ERR_INVALID_ARG;
   return FESD_OK;
+}
+
+static void level_free(fesd__level *L) {
+  fesd_ncp_free(&L->ncp);
+  free(L->jac);
+  free(L->draw);
+  free(L->dz);
+  memset(L, 0, sizeof(*L));
 }
 
 void fesd_free(fesd_integrator **itp) {
   if (!itp || !*itp) return;
   fesd_integrator *it = *itp;
-  fesd_ncp_free(&it->ncp);
+  for (int l = 0; l < it->n_lv; l++) level_free(&it->lv[l]);
   fesd__point_free(&it->pscr);
   fesd__system_free(&it->sys);
   fesd__model_free(&it->model);
-  double *bufs[] = {it->x, it->lam00, it->theta_prev, it->u_cur, it->z, it->zws, it->z0, it->zpred,
-                    it->raw, it->jac, it->lb, it->ub, it->Sx, it->Su, it->draw, it->dz, it->Dtmp,
-                    it->Stmp, it->gbuf, it->blk, it->vtmp, it->pt_t, it->pt_q, it->pt_l, it->rec_h, it->rec_t,
-                    it->rec_x, it->rec_th, it->rec_la, it->rec_mu, it->rec_v};
+  double *bufs[] = {it->x,  it->lam00, it->theta_prev, it->u_cur, it->ws_blk, it->z,     it->z0,
+                    it->zpred, it->zp, it->raw,       it->lb,    it->ub,     it->Sx,    it->Su,
+                    it->Dtmp, it->Stmp, it->gbuf,     it->blk,   it->vtmp,   it->pt_t,  it->pt_q,
+                    it->pt_l, it->rec_h, it->rec_t,   it->rec_x, it->rec_th, it->rec_la, it->rec_mu,
+                    it->rec_v, it->zfast, it->bt};
   for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); i++) free(bufs[i]);
   for (fesd__saved *b = &it->bk; b <= &it->bk_sub; b++) {
-    double *saved[] = {b->x, b->lam, b->th, b->zws, b->Sx, b->Su, b->ldp};
+    double *saved[] = {b->x, b->lam, b->th, b->blk, b->Sx, b->Su, b->ldp};
     for (size_t i = 0; i < sizeof(saved) / sizeof(saved[0]); i++) free(saved[i]);
   }
-  free(it->eq_active);
-  free(it->pair_mode);
-  free(it->pt_src);
-  free(it->kb);
-  free(it->sw_at);
-  free(it->act);
-  free(it->act0);
-  free(it->cand);
-  free(it->bmode);
-  free(it->exit_mode);
-  free(it->zfast);
+  void *other[] = {it->eq_active, it->pair_mode, it->pt_src, it->kb,   it->sw_at,    it->act,
+                   it->act0,      it->cand,      it->swap_set, it->bmode, it->exit_mode, it->jump_in,
+                   it->jump_out,  it->scan_buf,  it->plan,   it->plan_after, it->bseg};
+  for (size_t i = 0; i < sizeof(other) / sizeof(other[0]); i++) free(other[i]);
   free(it);
   *itp = NULL;
+}
+
+int fesd__ladder(const fesd_integrator *it, int N) {
+  /* every count up to 8, then steps of about 1.5 (few workspaces, at most 50 % spare) */
+  int L = it->set.n_fe;
+  while (L < N) L = L < 8 ? L + 1 : L + (L + 1) / 2;
+  return L < it->N_cap ? L : it->N_cap;
+}
+
+int fesd__use_level(fesd_integrator *it, int N) {
+  fesd__system *S = &it->sys;
+  int l = 0;
+  while (l < it->n_lv && it->lv[l].N != N) l++;
+  if (l == it->n_lv) {
+    if (it->n_lv == FESD__MAX_LEVELS) return FESD_ERR_TOO_MANY_SWITCHES;
+    fesd__system_set_N(S, N);
+    fesd__level *L = &it->lv[l];
+    memset(L, 0, sizeof(*L));
+    L->N = N;
+    const size_t nnz = (size_t)S->nnz;
+    int *row = malloc((nnz > 0 ? nnz : 1) * sizeof(int)), *col = malloc((nnz > 0 ? nnz : 1) * sizeof(int));
+    int st = row && col ? FESD_OK : FESD_ERR_NOMEM;
+    if (st == FESD_OK) {
+      fesd__system_pattern(S, row, col);
+      fesd_ncp_problem p = {S->n, S->n_eq, S->n_pair, S->nnz, row, col, fesd__system_eval, S};
+      fesd_ncp_settings ns = it->set.ncp;
+      ns.tol = it->set.newton_tol;
+      st = fesd_ncp_setup(&L->ncp, &p, &ns);
+    }
+    free(row);
+    free(col);
+    if (st == FESD_OK && it->set.sensitivities) {
+      const size_t np = (size_t)it->np;
+      L->jac = malloc((nnz > 0 ? nnz : 1) * sizeof(double));
+      L->draw = malloc((size_t)S->n_raw * np * sizeof(double) + 1);
+      L->dz = malloc((size_t)S->n * np * sizeof(double) + 1);
+      if (!L->jac || !L->draw || !L->dz) st = FESD_ERR_NOMEM;
+    }
+    if (st) {
+      level_free(L);
+      fesd__system_set_N(S, it->lv_cur < it->n_lv ? it->lv[it->lv_cur].N : N);
+      return st;
+    }
+    it->n_lv++;
+  }
+  it->lv_cur = l;
+  it->ncp = it->lv[l].ncp;
+  if (S->N != N) fesd__system_set_N(S, N);
+  return FESD_OK;
 }
 
 static double *dalloc(size_t n, int *fail) {
@@ -95,7 +148,8 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
     free(it);
     return st;
   }
-  if ((st = fesd__system_init(&it->sys, &it->model, &tab, settings->n_fe, settings->sensitivities))) {
+  it->N_cap = settings->max_elements;
+  if ((st = fesd__system_init(&it->sys, &it->model, &tab, it->N_cap, settings->sensitivities))) {
     fesd__model_free(&it->model);
     free(it);
     return st;
@@ -104,27 +158,28 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   it->tab = tab;
   fesd_tableau_get(FESD_RK_GAUSS_LEGENDRE, tab.s, &it->quad);
   fesd__interior_setup(it);
-  it->n = S->n;
+  it->n = S->n; /* unknowns of the largest layout */
   it->nx = model->nx;
   it->nu = model->nu;
   it->nth = it->model.nth;
   it->nsys = model->nsys;
-  it->N = S->N;
   it->s = S->s;
   it->np = it->nx + it->nu;
   const size_t n = (size_t)S->n, nx = (size_t)it->nx, nu = (size_t)it->nu, nth = (size_t)it->nth;
-  const size_t np = (size_t)it->np, N = (size_t)S->N, s = (size_t)S->s;
+  const size_t np = (size_t)it->np, N = (size_t)it->N_cap, s = (size_t)S->s, nsys = (size_t)it->nsys;
+  it->cap_plan = 2 * it->N_cap;
+  const size_t cp = (size_t)it->cap_plan;
   int fail = 0;
   it->x = dalloc(nx, &fail);
   it->lam00 = dalloc(nth, &fail);
   it->theta_prev = dalloc(nth, &fail);
   it->u_cur = dalloc(nu, &fail);
+  it->ws_blk = dalloc((size_t)S->sb, &fail);
   it->z = dalloc(n, &fail);
-  it->zws = dalloc(n, &fail);
   it->z0 = dalloc(n, &fail);
   it->zpred = dalloc(n, &fail);
+  it->zp = dalloc(n, &fail);
   it->raw = dalloc((size_t)S->n_raw, &fail);
-  it->jac = dalloc((size_t)S->nnz, &fail);
   it->lb = dalloc(n, &fail);
   it->ub = dalloc(n, &fail);
   /* sensitivity storage is O(n_x^2): only when asked for */
@@ -133,17 +188,13 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
     b->x = dalloc(nx, &fail);
     b->lam = dalloc(nth, &fail);
     b->th = dalloc(nth, &fail);
-    b->zws = dalloc(n, &fail);
+    b->blk = dalloc((size_t)S->sb, &fail);
     b->Sx = dalloc(sx * sx, &fail);
     b->Su = dalloc(sx * nu, &fail);
     b->ldp = dalloc(settings->sensitivities ? nth * np : 1, &fail);
   }
   it->Sx = dalloc(sx * sx, &fail);
   it->Su = dalloc(sx * nu, &fail);
-  if (settings->sensitivities) {
-    it->draw = dalloc((size_t)S->n_raw * np, &fail);
-    it->dz = dalloc(n * np, &fail);
-  }
   it->Dtmp = dalloc(settings->sensitivities ? (nx > nth ? nx : nth) * np : 1, &fail);
   it->Stmp = dalloc(settings->sensitivities ? nx * (nx > nu ? nx : nu) : 1, &fail);
   it->gbuf = dalloc(nth + nx, &fail);
@@ -153,35 +204,32 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   it->pt_t = dalloc(N * (s + 1) + 1, &fail);
   it->pt_q = dalloc((N * (s + 1) + 1) * nth, &fail);
   it->pt_l = dalloc((N * (s + 1) + 1) * nth, &fail);
-  it->cap_el = (int)N << settings->max_splits;
-  size_t cap = (size_t)it->cap_el;
-  it->rec_h = dalloc(cap, &fail);
-  it->rec_t = dalloc(cap + 1, &fail);
-  it->rec_x = dalloc((cap + 1) * nx, &fail);
-  it->rec_th = dalloc(cap * s * nth, &fail);
-  it->rec_la = dalloc(cap * s * nth, &fail);
-  it->rec_mu = dalloc(cap * s * (size_t)it->nsys, &fail);
-  it->rec_v = dalloc(cap * s * nx, &fail);
+  it->zfast = dalloc(n, &fail);
+  it->bt = dalloc(cp + 2, &fail);
   it->eq_active = malloc((size_t)S->n_eq);
   it->pair_mode = malloc((size_t)(S->n_pair > 0 ? S->n_pair : 1));
   it->pt_src = malloc((N * (s + 1) + 1) * sizeof(int));
-  it->kb = malloc((N + 1) * sizeof(int));
+  it->kb = malloc((cp + N + 2) * sizeof(int));
   it->sw_at = malloc((N + 1) * sizeof(int));
   it->act = malloc(N * s * nth); /* per stage */
   it->act0 = malloc(nth);
   it->cand = malloc(nth);
+  it->swap_set = malloc(nth);
   it->bmode = calloc(N + 1, sizeof(int));
   it->exit_mode = calloc(N + 1, sizeof(int));
-  it->zfast = dalloc(n, &fail);
+  it->jump_in = malloc(nsys * sizeof(int));
+  it->jump_out = malloc(nsys * sizeof(int));
+  it->scan_buf = malloc(nsys * sizeof(*it->scan_buf));
+  it->plan = malloc(cp * sizeof(*it->plan));
+  it->plan_after = malloc(cp * nth);
+  it->bseg = malloc((cp + 2) * sizeof(int));
   if (fail || !it->eq_active || !it->pair_mode || !it->pt_src || !it->kb || !it->sw_at || !it->act ||
-      !it->act0 || !it->cand || !it->bmode || !it->exit_mode) {
+      !it->act0 || !it->cand || !it->swap_set || !it->bmode || !it->exit_mode || !it->jump_in ||
+      !it->jump_out || !it->scan_buf || !it->plan || !it->plan_after || !it->bseg) {
     fesd_free(&it);
     return FESD_ERR_NOMEM;
   }
-  fesd_ncp_problem p = {S->n, S->n_eq, S->n_pair, S->nnz, S->prow, S->pcol, fesd__system_eval, S};
-  fesd_ncp_settings ns = settings->ncp;
-  ns.tol = settings->newton_tol;
-  if ((st = fesd_ncp_setup(&it->ncp, &p, &ns))) {
+  if ((st = fesd__grow_records(it, 2 * it->N_cap)) || (st = fesd__use_level(it, settings->n_fe))) {
     fesd_free(&it);
     return st;
   }
@@ -198,6 +246,7 @@ int fesd_set_state(fesd_integrator *it, double t0, const double *x0, const doubl
   memcpy(it->x, x0, (size_t)it->nx * sizeof(double));
   it->have_ws = 0;
   it->have_prev_theta = 0;
+  fesd__system_reset_refs(&it->sys);
   if (it->set.sensitivities) {
     memset(it->Sx, 0, (size_t)it->nx * it->nx * sizeof(double));
     for (int i = 0; i < it->nx; i++) it->Sx[i * it->nx + i] = 1.0;
@@ -223,7 +272,7 @@ void fesd__save(fesd_integrator *it, fesd__saved *b) {
   memcpy(b->x, it->x, nx * sizeof(double));
   memcpy(b->lam, it->lam00, nth * sizeof(double));
   memcpy(b->th, it->theta_prev, nth * sizeof(double));
-  memcpy(b->zws, it->zws, (size_t)it->n * sizeof(double));
+  memcpy(b->blk, it->ws_blk, (size_t)it->sys.sb * sizeof(double));
   if (!it->set.sensitivities) return; /* O(n_x^2) state only then */
   memcpy(b->Sx, it->Sx, nx * nx * sizeof(double));
   memcpy(b->Su, it->Su, nx * nu * sizeof(double));
@@ -240,7 +289,7 @@ void fesd__load(fesd_integrator *it, const fesd__saved *b) {
   memcpy(it->x, b->x, nx * sizeof(double));
   memcpy(it->lam00, b->lam, nth * sizeof(double));
   memcpy(it->theta_prev, b->th, nth * sizeof(double));
-  memcpy(it->zws, b->zws, (size_t)it->n * sizeof(double));
+  memcpy(it->ws_blk, b->blk, (size_t)it->sys.sb * sizeof(double));
   if (!it->set.sensitivities) return;
   memcpy(it->Sx, b->Sx, nx * nx * sizeof(double));
   memcpy(it->Su, b->Su, nx * nu * sizeof(double));
@@ -262,7 +311,9 @@ int fesd_step(fesd_integrator *it, const double *u, double T, fesd_step_info *in
   it->n_events = 0;
   fesd__save(it, &it->bk);
   it->model.failed = NULL;
+  const double t_start = it->t;
   int st = fesd__substep(it, u, T, 0, info);
+  if (st == FESD_OK) it->t = t_start + T; /* sub-steps add up to T up to round-off */
   info->time = fesd__wall_time() - t0;
   info->status = st;
   if (st != FESD_ERR_CALLBACK && st != FESD_ERR_NONFINITE) info->failed_callback = NULL;
@@ -280,9 +331,11 @@ int fesd_step(fesd_integrator *it, const double *u, double T, fesd_step_info *in
   S->homotopy_stages += info->homotopy_stages;
   S->splits += info->splits;
   S->fallback_steps += info->fallback;
+  S->substeps += info->substeps;
+  S->nonunique_steps += (info->flags & FESD_FLAG_NONUNIQUE) != 0;
   S->events += it->n_events;
   S->time += info->time;
-  int sw = info->switch_step || info->splits > 0;
+  int sw = info->switch_step || info->splits > 0 || info->substeps > 0;
   if (sw) {
     S->switch_steps++;
     it->sum_iter_sw += info->newton_iter;

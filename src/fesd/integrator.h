@@ -8,12 +8,47 @@
 #include "fesd_ncp.h"
 
 #define FESD_MAX_EVENTS_PER_STEP 256
+/* Element counts with a solver workspace of their own (the ladder of layouts, integrator.c). */
+#define FESD__MAX_LEVELS 24
+
+/* The solver workspace of one element count N (created at its first use: a step that holds
+ * more switches than N_FE - 1 gets more elements), with the sensitivity buffers of that size. */
+typedef struct {
+  int N;
+  fesd_ncp *ncp;
+  double *jac, *draw, *dz;
+} fesd__level;
+
+/* A switch of one subsystem inside the step, as planned for the next solve (plan.c). */
+typedef struct {
+  double t;  /* time from the step start: predicted, then the solved boundary time */
+  int sys;   /* subsystem */
+  int mode;  /* the mode whose sign was violated: entering, or leaving (exit) */
+  int exit;  /* 1: an active mode leaves (its sliding multiplier reached 0): pinned exit row */
+  int kb;    /* element boundary carrying it in the current layout */
+  int tries; /* active sets tried after it */
+} fesd__switch;
+
+/* A sign violation of a fixed active set, or an invalid sliding mode (verify.c). */
+typedef struct {
+  int found;
+  double t;     /* predicted switch time (relative to the step start) */
+  int mode;     /* stacked mode index */
+  int sys;
+  int enter;    /* 1: an inactive mode's lambda went negative; 0: an active theta did */
+  int element;  /* element where it was detected */
+  int stage;    /* stage index n*s + j of the violating point (n*s + s: element end or midpoint) */
+  int first;    /* detected at the first checked point after an active-set change of its
+                   subsystem (the change itself chose the wrong modes) */
+  int filippov; /* the subsystem's 2-mode sliding fails Filippov's conditions here: `mode` is
+                   the mode whose field points into its own region (-1: both: repulsive) */
+} fesd__violation;
 
 /* A saved state (integrator.c): the step start, restored when fesd_step fails, and the start
  * of a sub-step attempt, restored before halving (a failure inside accept, e.g. a callback
  * at the new state, can leave the state half-updated). */
 typedef struct {
-  double t, *x, *lam, *th, *zws, *Sx, *Su, *ldp;
+  double t, *x, *lam, *th, *blk, *Sx, *Su, *ldp;
   int have_ws, have_prev_theta, n_el, n_events;
 } fesd__saved;
 
@@ -21,35 +56,49 @@ struct fesd_integrator {
   fesd_settings set;
   fesd__model model;
   fesd__system sys;
-  fesd_ncp *ncp;
-  int n, nx, nu, nth, nsys, N, s, np;
+  fesd_ncp *ncp; /* the workspace of the current layout (a level's) */
+  fesd__level lv[FESD__MAX_LEVELS];
+  int n_lv, N_cap, lv_cur;
+  int n, nx, nu, nth, nsys, s, np;
   /* current state */
   double t;
-  double *x, *lam00, *theta_prev, *u_cur;
+  double *x, *lam00, *theta_prev, *u_cur, *ws_blk; /* ws_blk: last stage block of the last step */
   int have_state, have_ws, have_prev_theta;
-  /* step data */
-  double *z, *zws, *z0, *zpred, *raw, *jac, *lb, *ub;
+  /* step data (sized for N_cap elements) */
+  double *z, *z0, *zpred, *zp, *raw, *lb, *ub;
   unsigned char *eq_active, *pair_mode;
   fesd__saved bk, bk_sub; /* step start, sub-step start */
   /* sensitivities */
-  double *Sx, *Su, *draw, *dz, *Dtmp, *Stmp;
+  double *Sx, *Su, *Dtmp, *Stmp;
   double *gbuf, *blk, *vtmp; /* vtmp: 2 nx */
   fesd__point_eval pscr;     /* scratch model evaluation */
   double *pt_t, *pt_q, *pt_l; /* switch prediction: point times and q values */
   int *pt_src, *kb, *sw_at;
-  /* active-set path */
-  unsigned char *act, *act0, *cand;
+  /* active sets: per stage (act), at the step start (act0), per element boundary */
+  unsigned char *act, *act0, *cand, *swap_set;
   int *bmode, *exit_mode;
   double *zfast;
-  int jump_in, jump_out; /* switch exactly at the step start (mode entering, mode left), or -1 */
-  /* records of the last accepted step */
+  int *jump_in, *jump_out; /* per subsystem: a switch exactly at the step start (mode entering,
+                              mode left), or -1 */
+  fesd__violation *scan_buf; /* nsys */
+  int nonunique;           /* the step started on a surface that the fields on both sides leave */
+  /* the switch plan of the current (sub)step and the active set after each switch (rows of
+   * nth flags; only the switch's subsystem is used) */
+  fesd__switch *plan;
+  unsigned char *plan_after;
+  int n_plan, cap_plan;
+  double merge_tol; /* switches of different subsystems closer than this share a boundary */
+  double *bt;       /* boundary times of the layout (cap_plan + 2) */
+  int *bseg;        /* elements per segment (cap_plan + 1) */
+  /* records of the last accepted step (grown outside the Newton loop) */
   int cap_el, n_el;
   double *rec_h, *rec_t, *rec_x, *rec_th, *rec_la, *rec_mu, *rec_v;
   fesd_tableau tab, quad; /* the method, and a Gauss rule for dense output */
-  /* interior sign check: collocation weights at the midpoints between consecutive
-   * nodes {0, c_j, 1} (fixed by the tableau, so computed once at create) */
+  /* interior checks: collocation weights at the midpoints between consecutive nodes
+   * {0, c_j, 1} (fixed by the tableau, so computed once at create) */
   int n_mid;
   double mid_w[(FESD_RK_MAX_STAGES + 1) * FESD_RK_MAX_STAGES];
+  double mid_tau[FESD_RK_MAX_STAGES + 1];
   fesd_event events[FESD_MAX_EVENTS_PER_STEP];
   int n_events;
   fesd_stats stats;
@@ -59,9 +108,16 @@ struct fesd_integrator {
 /* w_j = int_0^tau l_j (Lagrange basis on the nodes c): the collocation polynomial of an
  * element is x_n + h sum_j w_j(tau) v_j. w has s entries. */
 void fesd__colloc_weights(const fesd_integrator *it, double tau, double *w);
-/* Fill n_mid and mid_w (active.c). */
+/* Fill n_mid, mid_tau and mid_w (verify.c). */
 void fesd__interior_setup(fesd_integrator *it);
 void fesd__save(fesd_integrator *it, fesd__saved *b);
 void fesd__load(fesd_integrator *it, const fesd__saved *b);
+/* Select the layout of N elements: the system's offsets and the solver workspace of N
+ * (created at its first use). FESD_ERR_NOMEM / FESD_ERR_LINSOLVE from the creation. */
+int fesd__use_level(fesd_integrator *it, int N);
+/* The element count of the ladder that holds at least N elements (at most N_cap). */
+int fesd__ladder(const fesd_integrator *it, int N);
+/* Whether the method has a collocation polynomial (dense output, interior checks). */
+int fesd__collocation(const fesd_integrator *it);
 
 #endif

@@ -154,7 +154,7 @@ int fesd__resort_guess(fesd_integrator *it, const double *zsrc, double T, const 
       const double *blk = source_block(it, zsrc, np, t_lo, t_hi, tm);
       if (!blk) {
         if (c == 0 && it->have_ws)
-          blk = it->zws + fesd__v(S, N - 1, S->s - 1);
+          blk = it->ws_blk;
         else
           blk = source_block(it, zsrc, np, c == 0 ? -INFINITY : t_lo, INFINITY, tm);
       }

@@ -1,25 +1,40 @@
-/* One integration step: the solve strategy (measured in ../shared/notes/solver_prototype.md,
- * strategy S2c, verified in C):
- *  (a) solve the equal-h (standard) system at sigma = 0 from the warm start; if it
- *      converges and every cross-complementarity product vanishes, equal h is an
- *      exact FESD solution: accept;
- *  (b) otherwise predict the switch times from the sign changes of
- *      q_i = lambda_i - theta_i along the stage points (of (a)'s solution, or of a
- *      short smoothed predictor sigma = 1e-1..1e-3 when (a) failed);
- *  (c) re-sort the elements around the predicted switches and solve the square
- *      FESD system whose boundary rows are the binding ones (Theorem 3): the
- *      compact cross-complementarity row at a switching boundary, h_k = h_{k-1}
- *      elsewhere, and sum h = T; sigma-homotopy as fallback;
- *  (d) verify (all sparse cross products, h > 0); on failure the caller halves the step. */
+/* One integration step: the solve strategy.
+ *
+ * FESD (plan path): every solve has fixed active sets, so the step system is smooth and
+ * Newton converges quadratically:
+ *  (a) solve with the start's active set everywhere, equal h, from the warm start;
+ *  (b) check the solution (verify.c); each subsystem's earliest violation predicts a switch;
+ *  (c) the plan gives every predicted switch its own element boundary with the binding row
+ *      (cross complementarity, or a pinned sliding exit), more elements when the step holds
+ *      more switches than N_FE - 1; solve from the previous solution regridded onto the new
+ *      elements; back to (b) until nothing is violated.
+ * A step that holds more switches than max_elements - 1 ends early, midway between two
+ * switches (a sub-step), and the rest of the step follows.
+ * If a plan cannot be solved, the FB fallback: the FB system with the smoothing homotopy
+ * (equal-h solve, smoothed predictor, re-sorted reduced system), verified like the rest.
+ * A step that still fails is halved recursively (settings.max_splits): the last resort, for a
+ * Zeno accumulation.
+ *
+ * Standard method: the same smooth solves with per-stage active sets (a sign violated at a
+ * stage changes that stage and the later ones). */
 #include <math.h>
 #include <string.h>
 
+#include <stdio.h>
+#include <stdlib.h>
 #include "common/timer.h"
 #include "fesd/integrator.h"
 #include "fesd/step.h"
 
-/* A callback failed (error code, NaN/Inf): no other path of this attempt can succeed. */
-static int cb_failed(int st) { return st == FESD_ERR_CALLBACK || st == FESD_ERR_NONFINITE; }
+/* A callback failed (error code, NaN/Inf) or memory ran out: no other path can succeed. */
+static int hard_failure(int st) {
+  return st == FESD_ERR_CALLBACK || st == FESD_ERR_NONFINITE || st == FESD_ERR_NOMEM;
+}
+
+/* Plan rounds of one step attempt (each one smooth solve). */
+#define MAX_ROUNDS 24
+/* A sub-step ends before this many boundaries when the plan holds more (see plan_cut). */
+#define SUB_MARGIN 1
 
 /* ---------- row selections ---------- */
 
@@ -35,7 +50,7 @@ static int rows_select(fesd_integrator *it, const int *switch_at) {
   return fesd_ncp_set_rows(it->ncp, it->eq_active, it->pair_mode);
 }
 
-static void set_h_bounds(fesd_integrator *it, double T) {
+static int set_h_bounds(fesd_integrator *it, double T) {
   fesd__system *S = &it->sys;
   for (int i = 0; i < S->n; i++) {
     it->lb[i] = -INFINITY;
@@ -45,7 +60,7 @@ static void set_h_bounds(fesd_integrator *it, double T) {
     it->lb[S->ho[n]] = 1e-9 * T;
     it->ub[S->ho[n]] = T;
   }
-  fesd_ncp_set_bounds(it->ncp, it->lb, it->ub);
+  return fesd_ncp_set_bounds(it->ncp, it->lb, it->ub);
 }
 
 static void accumulate(fesd_step_info *info, const fesd_ncp_info *ni) {
@@ -56,29 +71,60 @@ static void accumulate(fesd_step_info *info, const fesd_ncp_info *ni) {
   info->residual = ni->residual;
 }
 
+/* The solver keeps the row weights of one solve fixed (weights.c: from the sizes of the terms
+ * at the initial guess); at the solution they are recomputed and the residual checked again,
+ * and Newton continues with the new weights when it does not pass (a guess far off in size,
+ * e.g. a stiff transient in the warm start). */
 static int solve(fesd_integrator *it, double *z, double sigma, double tol, int max_iter,
                  int homotopy, fesd_step_info *info) {
+  fesd__system *S = &it->sys;
   fesd_ncp_settings ns = it->set.ncp;
   ns.tol = tol;
   ns.max_iter = max_iter;
   fesd_ncp_update_settings(it->ncp, &ns);
-  fesd_ncp_info ni;
-  int st = homotopy ? fesd_ncp_solve_homotopy(it->ncp, z, &ni) : fesd_ncp_solve(it->ncp, z, sigma, &ni);
-  accumulate(info, &ni);
+  int st = FESD_OK;
+  for (int pass = 0; pass < 3; pass++) {
+    if ((st = fesd__system_weights(S, z))) break;
+    if (getenv("FESD_DEBUG2")) {
+      fprintf(stderr, "pass %d weights:", pass);
+      for (int r = 0; r < S->n_raw; r++) fprintf(stderr, " %.2g", S->wraw[r]);
+      fprintf(stderr, "\n");
+    }
+    if (pass > 0) {
+      double res;
+      if ((st = fesd_ncp_residual(it->ncp, z, sigma, NULL, &res))) break;
+      info->residual = res;
+      if (res <= tol) return FESD_OK;
+      homotopy = 0; /* continue from the solution */
+    }
+    fesd_ncp_info ni;
+    st = homotopy ? fesd_ncp_solve_homotopy(it->ncp, z, &ni) : fesd_ncp_solve(it->ncp, z, sigma, &ni);
+    accumulate(info, &ni);
+    if (st && getenv("FESD_DEBUG2")) {
+      fesd__system_eval(z, it->raw, NULL, S);
+      fprintf(stderr, "failed solve: raw weighted rows:");
+      for (int r = 0; r < S->n_raw; r++) fprintf(stderr, " %d:%.2g(w%.2g)", r, it->raw[r], S->wraw[r]);
+      fprintf(stderr, "\n");
+      double *Fa = it->zpred; /* scratch */
+      fesd_ncp_residual(it->ncp, z, sigma, Fa, NULL);
+      fprintf(stderr, "assembled F:");
+      for (int r = 0; r < fesd_ncp_rows(it->ncp); r++) if (fabs(Fa[r]) > 1e-12) fprintf(stderr, " %d:%.3g", r, Fa[r]);
+      fprintf(stderr, "\n");
+    }
+    if (st) break;
+    st = FESD_ERR_MAX_ITER;
+  }
   if (st == FESD_ERR_CALLBACK || st == FESD_ERR_NONFINITE) {
-    int ms = it->sys.status;
+    int ms = S->status;
     if (ms == FESD_ERR_CALLBACK || ms == FESD_ERR_NONFINITE) st = ms;
     info->failed_callback = it->model.failed;
   }
   return st;
 }
 
-/* ---------- initial guesses ---------- */
-
-/* ---------- checks ---------- */
-
 /* Max over elements, modes and stage pairs m != m' of theta_{n,m,i} lambda_{n,m',i}
- * (boundary lambdas included): the sparse cross complementarity (eq. cross_cc_true). */
+ * (boundary lambdas included, weighted like the rows): the sparse cross complementarity
+ * (eq. cross_cc_true). */
 double fesd__cc_max(const fesd__system *S, const double *z) {
   double worst = 0;
   for (int n = 0; n < S->N; n++) {
@@ -91,37 +137,24 @@ double fesd__cc_max(const fesd__system *S, const double *z) {
         double lmax = fmax(L[i], R ? R[i] : 0.0);
         for (int mp = 0; mp < S->s; mp++)
           if (mp != m) lmax = fmax(lmax, z[fesd__la(S, n, mp) + i]);
-        worst = fmax(worst, th * lmax);
+        worst = fmax(worst, th * lmax * S->wth[i]);
       }
   }
   return worst;
 }
 
-int fesd__valid(fesd_integrator *it, const double *z, double *ccm) {
-  fesd__system *S = &it->sys;
-  for (int n = 0; n < S->N; n++)
-    if (!(z[S->ho[n]] > 0)) return 0;
-  *ccm = fesd__cc_max(S, z);
-  /* boundary LP points (methods with c_s != 1): lambda >= 0 there too, otherwise the
-   * active set changed between the last stage and the element end */
-  if (S->bp)
-    for (int n = 0; n < S->N; n++)
-      for (int i = 0; i < S->nth; i++) *ccm = fmax(*ccm, -z[S->lbo[n] + i]);
-  return *ccm <= it->set.cc_tol;
-}
+/* ---------- FB path: equal-h FB solve, predictor, reduced FB solve ---------- */
 
-/* ---------- FB path: equal-h FB solve, predictor, reduced FB solve (S2c) ---------- */
-
-/* z0 holds the initial guess; on success z is an accepted solution. */
+/* z0 holds the initial guess (N_FE layout); on success z is a converged solution. */
 static int fb_path(fesd_integrator *it, double T, fesd_step_info *info) {
   fesd__system *S = &it->sys;
   const double tol = it->set.newton_tol;
-  double *z = it->z, *z0 = it->z0, *zp = it->zpred, ccm = 0;
+  double *z = it->z, *z0 = it->z0, *zp = it->zpred;
   int st;
   if ((st = rows_select(it, NULL))) return st;
   memcpy(z, z0, (size_t)S->n * sizeof(double));
   st = solve(it, z, 0.0, tol, it->set.max_iter_first, 0, info);
-  if (cb_failed(st)) return st;
+  if (hard_failure(st)) return st;
   if (it->set.method == FESD_METHOD_STANDARD) {
     if (st != FESD_OK) {
       memcpy(z, z0, (size_t)S->n * sizeof(double));
@@ -129,7 +162,8 @@ static int fb_path(fesd_integrator *it, double T, fesd_step_info *info) {
     }
     return st;
   }
-  if (st == FESD_OK && fesd__valid(it, z, &ccm)) return FESD_OK;
+  double ccm;
+  if (st == FESD_OK && fesd__verify(it, z, &ccm) == FESD_OK) return FESD_OK;
   /* predictor */
   if (st == FESD_OK) {
     memcpy(zp, z, (size_t)S->n * sizeof(double));
@@ -138,7 +172,7 @@ static int fb_path(fesd_integrator *it, double T, fesd_step_info *info) {
     int ok = 0;
     for (double sigma = 1e-1; sigma >= 0.9e-3; sigma *= 0.1) {
       int s2 = solve(it, zp, sigma, 1e-2 * sigma, 20, 0, info);
-      if (cb_failed(s2)) return s2;
+      if (hard_failure(s2)) return s2;
       ok = (s2 == FESD_OK) || ok;
       if (s2 != FESD_OK) break;
     }
@@ -153,68 +187,46 @@ static int fb_path(fesd_integrator *it, double T, fesd_step_info *info) {
   if ((st = rows_select(it, it->sw_at))) return st;
   memcpy(z, z0, (size_t)S->n * sizeof(double));
   st = solve(it, z, 0.0, tol, it->set.max_iter, 0, info);
-  if (cb_failed(st)) return st;
-  if (st != FESD_OK || !fesd__valid(it, z, &ccm)) {
+  if (hard_failure(st)) return st;
+  if (st != FESD_OK) {
     memcpy(z, z0, (size_t)S->n * sizeof(double));
     st = solve(it, z, 0.0, tol, it->set.max_iter, 1, info);
     if (st != FESD_OK) return st;
-    if (!fesd__valid(it, z, &ccm)) return FESD_ERR_STEP_FAILED;
   }
   info->switch_step = 1;
   return FESD_OK;
 }
 
-/* ---------- active-set path ---------- */
+/* ---------- smooth solves with fixed active sets ---------- */
 
-/* Solve with the per-stage active sets it->act and boundary modes it->bmode from the
- * guess in z; success means converged and sign-verified (v reports a violation). */
-static int active_solve(fesd_integrator *it, double *z, int max_iter, fesd__violation *v,
-                        fesd_step_info *info) {
+/* Solve with the per-stage active sets it->act and boundary rows it->bmode from the guess in z. */
+static int fixed_solve(fesd_integrator *it, double *z, int max_iter, fesd_step_info *info) {
   int st = fesd__rows_active(it, it->act, it->bmode, it->exit_mode);
   if (st) return st;
   st = solve(it, z, 0.0, it->set.newton_tol, max_iter, 0, info);
   if (st) return st;
-  for (int n = 0; n < it->N; n++)
+  for (int n = 0; n < it->sys.N; n++)
     if (!(z[it->sys.ho[n]] > 0)) return FESD_ERR_STEP_FAILED;
-  fesd__find_violation(it, z, it->act, it->set.method == FESD_METHOD_STANDARD, v);
-  return v->found ? FESD_ERR_STEP_FAILED : FESD_OK;
-}
-
-/* d/dt (g_i - g_j) along f_j at x: > 0 means mode j keeps the lead after a switch from i
- * to j (a crossing), < 0 that f_j pushes back to the surface (sliding). */
-static int crossing_first(fesd_integrator *it, const double *x, int i, int j, int *cross) {
-  fesd__model *m = &it->model;
-  fesd__point_eval pe = {0};
-  pe.F = it->pscr.F;
-  pe.g = it->pscr.g;
-  pe.dgdx = it->pscr.dgdx;
-  int st = fesd__model_eval(m, x, it->sys.u, &pe);
-  if (st) return st;
-  double *f = it->vtmp;
-  memset(f, 0, (size_t)m->nx * sizeof(double));
-  fesd__F_axpy(m, &pe, j, 1.0, f);
-  *cross = fesd__dg_dot(m, &pe, i, f) - fesd__dg_dot(m, &pe, j, f) > 0;
   return FESD_OK;
 }
 
-/* State of the fast-path solution z at time t (relative): the stage state nearest before t. */
-static const double *state_near(fesd_integrator *it, const double *z, double t) {
+/* The start's active set at every stage of the N_FE layout, from the warm start z0. */
+static int start_solve(fesd_integrator *it, fesd_step_info *info) {
   fesd__system *S = &it->sys;
-  const double *best = S->x0;
-  double tn = 0;
-  for (int n = 0; n < S->N; n++) {
-    if (tn > t) break;
-    best = n == 0 ? S->x0 : z + S->xo[n - 1];
-    tn += z[S->ho[n]];
-  }
-  return best;
+  for (int p = 0; p < S->N * S->s; p++) memcpy(it->act + (size_t)p * S->nth, it->act0, (size_t)S->nth);
+  memset(it->bmode, 0, (size_t)(S->N + 1) * sizeof(int));
+  memcpy(it->z, it->z0, (size_t)S->n * sizeof(double));
+  fesd__impose_active(it, it->z, it->act);
+  int st = fesd__consistent_guess(it, it->z);
+  if (st) return st;
+  return fixed_solve(it, it->z, it->set.max_iter_first, info);
 }
 
-/* Candidate active sets of subsystem v->sys after the violation v, best first: an exit
- * drops the mode; an entering mode j replaces the set (crossing) or joins it (sliding), in
- * the order given by the direction of f_j at x. cur: the active flags before. */
+/* Candidate active sets of subsystem v->sys after the violation v (standard method), best
+ * first: an exit drops the mode; an entering mode j replaces the set (crossing) or joins it
+ * (sliding), in the order given by the direction of the fields at the stage state. */
 static int candidates(fesd_integrator *it, const fesd__violation *v, const unsigned char *cur,
-                      const double *x, unsigned char cands[2][64], int *i_old_out) {
+                      const double *x, const double *theta, unsigned char cands[2][64]) {
   const fesd__model *m = &it->model;
   const int k0 = m->th_off[v->sys], k1 = m->th_off[v->sys + 1];
   if (k1 - k0 > 64) return 0;
@@ -226,13 +238,18 @@ static int candidates(fesd_integrator *it, const fesd__violation *v, const unsig
   for (int i = k0; i < k1; i++)
     if (cur[i] && i_old < 0) i_old = i;
   if (i_old < 0) return 0;
-  int cross = 1;
-  if (crossing_first(it, x, i_old, v->mode, &cross)) return 0;
+  fesd__point_eval pe = {0};
+  pe.F = it->pscr.F;
+  pe.g = it->pscr.g;
+  pe.dgdx = it->pscr.dgdx;
+  if (fesd__model_eval(&it->model, x, it->sys.u, &pe)) return 0;
+  double ai, aj;
+  fesd__normal_components(it, &pe, theta, i_old, v->mode, &ai, &aj);
+  const int cross = aj > 0;
   for (int i = k0; i < k1; i++) {
-    cands[!cross][i - k0] = i == v->mode;           /* crossing: j replaces the set */
-    cands[cross][i - k0] = cur[i] || i == v->mode;  /* sliding: j joins the set */
+    cands[!cross][i - k0] = i == v->mode;          /* crossing: j replaces the set */
+    cands[cross][i - k0] = cur[i] || i == v->mode; /* sliding: j joins the set */
   }
-  *i_old_out = i_old;
   return 2;
 }
 
@@ -248,9 +265,8 @@ static int std_switch(fesd_integrator *it, fesd__violation v, fesd_step_info *in
     const int p0 = v.stage, k0 = m->th_off[v.sys], k1 = m->th_off[v.sys + 1];
     if (p0 >= ns) return FESD_ERR_STEP_FAILED;
     unsigned char cands[2][64];
-    int i_old = -1;
     const double *x = S->X + (size_t)p0 * S->nx; /* the stage state of the last solve */
-    int nc = candidates(it, &v, it->act + (size_t)p0 * nth, x, cands, &i_old);
+    int nc = candidates(it, &v, it->act + (size_t)p0 * nth, x, z + fesd__th(S, p0 / S->s, p0 % S->s), cands);
     if (nc == 0) return FESD_ERR_STEP_FAILED;
     memcpy(it->zpred, z, (size_t)S->n * sizeof(double));
     int advanced = 0;
@@ -261,16 +277,18 @@ static int std_switch(fesd_integrator *it, fesd__violation v, fesd_step_info *in
       int st = fesd__consistent_guess(it, z);
       if (st) return st;
       fesd__violation v2;
-      v2.found = 0;
-      st = active_solve(it, z, it->set.max_iter, &v2, info);
-      if (cb_failed(st)) return st;
+      st = fixed_solve(it, z, it->set.max_iter, info);
+      if (hard_failure(st)) return st;
       if (st == FESD_OK) {
-        info->switch_step = 1; /* the active set changed inside the step */
-        return FESD_OK;
-      }
-      if (v2.found && v2.stage > p0) {
-        v = v2;
-        advanced = 1;
+        if ((st = fesd__scan(it, z, it->act, 1, &v2, NULL))) return st;
+        if (!v2.found) {
+          info->switch_step = 1; /* the active set changed inside the step */
+          return FESD_OK;
+        }
+        if (v2.stage > p0) {
+          v = v2;
+          advanced = 1;
+        }
       }
     }
     if (!advanced) return FESD_ERR_STEP_FAILED;
@@ -278,125 +296,128 @@ static int std_switch(fesd_integrator *it, fesd__violation v, fesd_step_info *in
   return FESD_ERR_STEP_FAILED;
 }
 
-static int active_path(fesd_integrator *it, double T, fesd_step_info *info) {
-  fesd__system *S = &it->sys;
-  const int N = S->N, nth = S->nth, s = S->s;
-  double *z = it->z, *zf = it->zfast;
+static int std_path(fesd_integrator *it, fesd_step_info *info) {
+  int st = start_solve(it, info);
+  if (getenv("FESD_DEBUG")) fprintf(stderr, "std start solve: %s\n", fesd_status_name(st));
+  if (st) return hard_failure(st) ? st : FESD_ERR_STEP_FAILED;
   fesd__violation v;
-  int st;
-  /* fast path: the start's active set at every stage, equal h */
-  for (int p = 0; p < N * s; p++) memcpy(it->act + (size_t)p * nth, it->act0, (size_t)nth);
-  memset(it->bmode, 0, (size_t)(N + 1) * sizeof(int));
-  memcpy(z, it->z0, (size_t)S->n * sizeof(double));
-  fesd__impose_active(it, z, it->act);
-  if ((st = fesd__consistent_guess(it, z))) return st;
-  st = active_solve(it, z, it->set.max_iter_first, &v, info);
-  if (st == FESD_OK) return FESD_OK;
-  if (st != FESD_ERR_STEP_FAILED || !v.found) return cb_failed(st) ? st : FESD_ERR_STEP_FAILED;
-  if (it->set.method == FESD_METHOD_STANDARD) return std_switch(it, v, info);
-  memcpy(zf, z, (size_t)S->n * sizeof(double));
-  /* candidate active sets after the switch */
-  const fesd__model *m = &it->model;
-  int k0 = m->th_off[v.sys], k1 = m->th_off[v.sys + 1], ncand = 0;
-  unsigned char cands[2][64];
-  if (k1 - k0 > 64) return FESD_ERR_STEP_FAILED;
-  int is_exit = !v.enter, i_old_mode = -1;
-  if (is_exit) {
-    if (!it->set.exit_rows || S->bp) return FESD_ERR_STEP_FAILED; /* paper formulation: FB path */
-    for (int i = k0; i < k1; i++) cands[0][i - k0] = it->act0[i] && i != v.mode;
-    ncand = 1;
-  } else {
-    int i_old = k0;
-    i_old_mode = k0;
-    for (int i = k0; i < k1; i++)
-      if (it->act0[i] && (!it->act0[i_old] || zf[fesd__th(S, 0, 0) + i] > zf[fesd__th(S, 0, 0) + i_old])) i_old = i;
-    int cross = 1;
-    i_old_mode = i_old;
-    if ((st = crossing_first(it, state_near(it, zf, v.t), i_old, v.mode, &cross))) return st;
-    for (int i = k0; i < k1; i++) {
-      cands[!cross][i - k0] = i == v.mode;                 /* crossing: j replaces the set */
-      cands[cross][i - k0] = it->act0[i] || i == v.mode;   /* sliding: j joins the set */
-    }
-    ncand = 2;
-  }
-  /* boundary carrying the switch; a switch at the very start changes the whole step */
-  const double tstar = v.t;
-  int kb = (int)lround(tstar / T * N);
-  if (kb < 1) kb = 1;
-  if (kb > N - 1) kb = N - 1;
-  int at_start = tstar <= 1e-9 * T;
-  for (int c = 0; c < ncand; c++) {
-    memcpy(z, zf, (size_t)S->n * sizeof(double));
-    memset(it->bmode, 0, (size_t)(N + 1) * sizeof(int));
-    for (int n = 0; n < N; n++) {
-      for (int j = 0; j < s; j++) {
-        unsigned char *a = it->act + (size_t)(n * s + j) * nth;
-        memcpy(a, it->act0, (size_t)nth);
-        if (at_start || n >= kb) memcpy(a + k0, cands[c], (size_t)(k1 - k0));
-      }
-      z[S->ho[n]] = at_start ? T / N : (n < kb ? tstar / kb : (T - tstar) / (N - kb));
-    }
-    if (!at_start) {
-      it->bmode[kb] = is_exit ? 2 : 1;
-      it->exit_mode[kb] = v.mode;
-    }
-    fesd__impose_active(it, z, it->act);
-    if ((st = fesd__consistent_guess(it, z))) return st;
-    fesd__violation v2;
-    st = active_solve(it, z, it->set.max_iter, &v2, info);
-    if (cb_failed(st)) return st;
-    if (st == FESD_OK) {
-      info->switch_step = !at_start;
-      /* a crossing or entry exactly at the step start: the step equations see no switch,
-       * so the sensitivities get the saltation matrix explicitly (fesd__start_jump) */
-      if (at_start && !is_exit) {
-        it->jump_in = v.mode;
-        it->jump_out = i_old_mode;
-      }
-      return FESD_OK;
-    }
-  }
-  return FESD_ERR_STEP_FAILED;
+  if ((st = fesd__scan(it, it->z, it->act, 1, &v, NULL))) return st;
+  return v.found ? std_switch(it, v, info) : FESD_OK;
 }
 
-/* ---------- one attempt at a (sub)step of length T ---------- */
+/* ---------- FESD plan path ---------- */
 
-static int try_step(fesd_integrator *it, const double *u, double T, fesd_step_info *info) {
+/* Shorten the (sub)step to hold the plan's first boundaries only (fesd__plan_cut). */
+static void shorten(fesd_integrator *it, double *T) {
+  const double cut = fesd__plan_cut(it, it->N_cap - 1 - SUB_MARGIN);
+  fesd__plan_truncate(it, cut);
+  *T = cut;
+  it->sys.T = cut;
+}
+
+static int plan_path(fesd_integrator *it, double *T, fesd_step_info *info) {
   fesd__system *S = &it->sys;
+  double *z = it->z, *zp = it->zp;
+  int Np = 0, st;
+  fesd__plan_reset(it);
+  if ((st = start_solve(it, info))) return hard_failure(st) ? st : FESD_ERR_STEP_FAILED;
+  for (int round = 0;; round++) {
+    fesd__plan_times(it, z);
+    fesd__violation v;
+    if ((st = fesd__scan(it, z, it->act, 0, &v, it->scan_buf))) return st;
+    if (getenv("FESD_DEBUG")) {
+      fprintf(stderr, "round %d N=%d T=%g plan:", round, S->N, S->T);
+      for (int e = 0; e < it->n_plan; e++) fprintf(stderr, " [t=%.6g sys %d mode %d exit %d kb %d]", it->plan[e].t, it->plan[e].sys, it->plan[e].mode, it->plan[e].exit, it->plan[e].kb);
+      fprintf(stderr, "\n");
+      for (int k = 0; k < it->nsys; k++) if (it->scan_buf[k].found) { fesd__violation *w = &it->scan_buf[k]; fprintf(stderr, "   viol sys %d t=%.6g mode %d enter %d el %d stage %d first %d fil %d\n", k, w->t, w->mode, w->enter, w->element, w->stage, w->first, w->filippov); }
+    }
+    if (!v.found) {
+      info->switch_step = it->n_plan > 0;
+      return FESD_OK;
+    }
+    if (round >= MAX_ROUNDS) return FESD_ERR_STEP_FAILED;
+    memcpy(zp, z, (size_t)S->n * sizeof(double));
+    Np = S->N;
+    int r = fesd__plan_update(it, zp, it->scan_buf);
+    if (r == FESD_ERR_TOO_MANY_SWITCHES) {
+      shorten(it, T);
+      r = 1;
+    }
+    if (r < 0) return r;
+    if (r == 0) return FESD_ERR_STEP_FAILED;
+    st = fesd__plan_layout(it, S->T, z);
+    if (st == FESD_ERR_TOO_MANY_SWITCHES) {
+      shorten(it, T);
+      st = fesd__plan_layout(it, S->T, z);
+    }
+    if (st) return st;
+    if ((st = set_h_bounds(it, S->T))) return st;
+    if ((st = fesd__regrid_guess(it, zp, Np, z))) return st;
+    st = fixed_solve(it, z, it->set.max_iter, info);
+    if (getenv("FESD_DEBUG")) fprintf(stderr, "  solve N=%d: %s res %.2e\n", S->N, fesd_status_name(st), info->residual);
+    if (st) return hard_failure(st) ? st : FESD_ERR_STEP_FAILED;
+  }
+}
+
+/* ---------- one attempt at a (sub)step of length *T (shortened when the step holds more
+ *            switches than the largest layout) ---------- */
+
+static int try_step(fesd_integrator *it, const double *u, double *T, fesd_step_info *info) {
+  fesd__system *S = &it->sys;
+  const double T_full = *T;
   S->x0 = it->x;
   S->u = u;
   S->lam00 = it->lam00;
-  S->T = T;
-  int st = fesd__initial_guess(it, u, T, it->z0);
+  S->T = *T;
+  int st = fesd__use_level(it, it->set.n_fe);
   if (st) return st;
-  set_h_bounds(it, T);
-  if ((st = fesd__act_start(it, u, it->act0))) return st;
-  it->jump_in = -1;
-  st = active_path(it, T, info);
-  if (cb_failed(st)) return st;
+  for (int k = 0; k < it->nsys; k++) it->jump_in[k] = it->jump_out[k] = -1;
+  if ((st = fesd__initial_guess(it, u, *T, it->z0))) return st;
+  if ((st = set_h_bounds(it, *T))) return st;
+  int nonunique = 0;
+  if ((st = fesd__act_start(it, u, it->act0, &nonunique))) return st;
+  it->nonunique = nonunique;
+  st = it->set.method == FESD_METHOD_FESD ? plan_path(it, T, info) : std_path(it, info);
+  if (hard_failure(st)) return st;
   if (st != FESD_OK) {
-    st = fb_path(it, T, info);
-    if (st) return st;
+    *T = T_full;
+    S->T = T_full;
+    for (int k = 0; k < it->nsys; k++) it->jump_in[k] = it->jump_out[k] = -1;
+    if ((st = fesd__use_level(it, it->set.n_fe))) return st;
+    if ((st = set_h_bounds(it, *T))) return st;
+    if ((st = fb_path(it, *T, info))) return st;
     info->fallback++;
-    it->jump_in = -1;
   }
   double ccm = 0;
-  if (it->set.method == FESD_METHOD_FESD && !fesd__valid(it, it->z, &ccm)) return FESD_ERR_STEP_FAILED;
-  if (it->set.method == FESD_METHOD_FESD && (st = fesd__interior_check(it, it->z))) return st;
-  info->cc_max = it->set.method == FESD_METHOD_FESD ? ccm : fesd__cc_max(S, it->z);
-  return fesd__accept(it, it->z, u, T);
+  if (it->set.method == FESD_METHOD_FESD && info->fallback && (st = fesd__verify(it, it->z, &ccm)))
+    return st;
+  info->cc_max = fesd__cc_max(S, it->z);
+  if (it->nonunique) info->flags |= FESD_FLAG_NONUNIQUE;
+  return fesd__accept(it, it->z, u, *T);
 }
 
 int fesd__substep(fesd_integrator *it, const double *u, double T, int depth, fesd_step_info *info) {
-  fesd__save(it, &it->bk_sub);
-  int st = try_step(it, u, T, info);
-  if (st == FESD_OK) return st;
-  fesd__load(it, &it->bk_sub); /* accept may have failed half-way */
-  if (st == FESD_ERR_CALLBACK) return st;
-  if (depth >= it->set.max_splits)
-    return st == FESD_ERR_TOO_MANY_SWITCHES || st == FESD_ERR_NONFINITE ? st : FESD_ERR_STEP_FAILED;
-  info->splits++;
-  st = fesd__substep(it, u, 0.5 * T, depth + 1, info);
-  if (st) return st;
-  return fesd__substep(it, u, 0.5 * T, depth + 1, info);
+  double done = 0;
+  while (done < T) {
+    double Ts = T - done;
+    fesd__save(it, &it->bk_sub);
+    const int fb = info->fallback;
+    int st = try_step(it, u, &Ts, info);
+    if (st == FESD_OK) {
+      if (Ts < T - done) info->substeps++;
+      done = Ts < T - done ? done + Ts : T;
+      continue;
+    }
+    info->fallback = fb;
+    fesd__load(it, &it->bk_sub); /* accept may have failed half-way */
+    if (hard_failure(st) && st != FESD_ERR_NONFINITE) return st;
+    if (depth >= it->set.max_splits)
+      return st == FESD_ERR_TOO_MANY_SWITCHES || st == FESD_ERR_NONFINITE ? st : FESD_ERR_STEP_FAILED;
+    info->splits++;
+    const double R = T - done, half = 0.5 * R;
+    st = fesd__substep(it, u, half, depth + 1, info);
+    if (st) return st;
+    return fesd__substep(it, u, R - half, depth + 1, info);
+  }
+  return FESD_OK;
 }

@@ -1,44 +1,84 @@
-/* Internal: step strategy (step.c). */
+/* Internal: the step strategy (step.c), the switch plan of a step (plan.c), the checks of a
+ * converged step (verify.c), initial guesses (guess.c), the FB fallback's predictor
+ * (predict.c), acceptance (accept.c). Row weights: system.h, weights.c. */
 #ifndef FESD_STEP_H
 #define FESD_STEP_H
 #include "fesd/integrator.h"
-/* Advance by T (recursively halving on failure up to settings.max_splits). */
+
+/* Advance by T (sub-steps at planned switches, recursive halving on failure up to
+ * settings.max_splits). */
 int fesd__substep(fesd_integrator *it, const double *u, double T, int depth, fesd_step_info *info);
-/* Max sparse cross-complementarity product of z. */
+/* Max sparse cross-complementarity product of z (weighted: units of the row scaling). */
 double fesd__cc_max(const fesd__system *S, const double *z);
 /* lambda00 = g(x) - min g per subsystem (and d/d(x,u) into sys.lam00_dp when deriv). */
 int fesd__update_lambda00(fesd_integrator *it, const double *x, const double *u, int deriv);
-/* A sign violation of a fixed active set (active.c). */
-typedef struct {
-  int found;
-  double t;     /* predicted switch time (relative to the step start) */
-  int mode;     /* stacked mode index */
-  int sys;
-  int enter;    /* 1: an inactive mode's lambda went negative; 0: an active theta did */
-  int element;  /* element where it was detected */
-  int stage;    /* stage index n*s + j of the violating point (n*s + s: element end) */
-} fesd__violation;
 
-/* active.c */
+/* ---- active.c ---- */
 void fesd__act_from_theta(const fesd_integrator *it, const double *theta, unsigned char *a);
-int fesd__act_start(fesd_integrator *it, const double *u, unsigned char *a);
+/* Active set at the step start; *nonunique set when x0 lies on a surface that the fields on
+ * both sides leave (several Filippov solutions). */
+int fesd__act_start(fesd_integrator *it, const double *u, unsigned char *a, int *nonunique);
 void fesd__impose_active(fesd_integrator *it, double *z, const unsigned char *act);
 int fesd__rows_active(fesd_integrator *it, const unsigned char *act, const int *bmode,
                       const int *exit_mode);
-int fesd__find_violation(fesd_integrator *it, const double *z, const unsigned char *act,
-                         int strict, fesd__violation *v);
-/* FESD_ERR_STEP_FAILED if the collocation polynomial enters a region between stage points. */
-int fesd__interior_check(fesd_integrator *it, const double *z);
-/* guess.c */
+/* Normal components d/dt (g_i - g_j) along the total field with mode i alone and with mode j
+ * alone in its subsystem (the other subsystems at theta) at an evaluated point. */
+void fesd__normal_components(fesd_integrator *it, const fesd__point_eval *pe, const double *theta,
+                             int i, int j, double *ai, double *aj);
+
+/* ---- verify.c ---- */
+/* Earliest violation of the active sets act (N*s blocks) in z over all subsystems (v) and, when
+ * per_sys is non-NULL, the earliest of each subsystem (nsys entries). strict (standard method):
+ * every stage is checked. Collocation methods are also checked between the stage points (the
+ * region of the collocation polynomial, and Filippov's conditions of 2-mode sliding modes).
+ * Returns FESD_OK or a callback status. */
+int fesd__scan(fesd_integrator *it, const double *z, const unsigned char *act, int strict,
+               fesd__violation *v, fesd__violation *per_sys);
+/* A converged FESD solution passes: h > 0, cross complementarity, and the scan of its own
+ * active sets (theta > active_tol) finds nothing. FESD_ERR_STEP_FAILED otherwise. */
+int fesd__verify(fesd_integrator *it, const double *z, double *ccm);
+/* Collocation polynomial of element n of z at the weights w (fesd__colloc_weights). */
+void fesd__poly_state(const fesd_integrator *it, const double *z, int n, const double *w, double *x);
+/* State of z at time t from the step start (collocation polynomial, or piecewise linear
+ * through the stage states for the other families). */
+void fesd__state_at(fesd_integrator *it, const double *z, int N, double t, double *x);
+
+/* ---- guess.c ---- */
 int fesd__initial_guess(fesd_integrator *it, const double *u, double T, double *z);
 int fesd__consistent_guess(fesd_integrator *it, double *z);
 void fesd__fill_element(fesd_integrator *it, double *z, int n, const double *block);
-/* predict.c (FB fallback path) */
+/* Guess for the current layout (it->act, h in z) from a solution zp on Np elements: states
+ * from zp's polynomials at the new stage times, theta from the new active sets (sliding:
+ * Filippov's multiplier at the state), lambda and mu from the indicators. */
+int fesd__regrid_guess(fesd_integrator *it, const double *zp, int Np, double *z);
+
+/* ---- predict.c (FB fallback path) ---- */
 int fesd__predict_switches(fesd_integrator *it, const double *z, double T, double *tc, int max_c);
 int fesd__resort_guess(fesd_integrator *it, const double *zsrc, double T, const double *tc, int nc,
                        int *sw_at, double *z);
-/* step.c */
-int fesd__valid(fesd_integrator *it, const double *z, double *ccm);
-/* accept.c */
+
+/* ---- plan.c ---- */
+/* Forget the plan (a step without switches). */
+void fesd__plan_reset(fesd_integrator *it);
+/* Element layout of the plan for a (sub)step of length T: boundaries, element count (a level of
+ * the ladder), per-stage active sets, boundary rows and element lengths (written into z).
+ * FESD_ERR_TOO_MANY_SWITCHES when the plan needs more than max_elements. */
+int fesd__plan_layout(fesd_integrator *it, double T, double *z);
+/* After a converged solve: switch times from the solved element lengths. */
+void fesd__plan_times(fesd_integrator *it, const double *z);
+/* Change the plan for the violations of a scan (per subsystem). Returns 1 if it changed,
+ * 0 if nothing can be changed (the caller gives up), or a negative status. */
+int fesd__plan_update(fesd_integrator *it, const double *z, const fesd__violation *per_sys);
+/* Keep only the switches before t (a shorter sub-step). */
+void fesd__plan_truncate(fesd_integrator *it, double t);
+/* Time before which at most n_max switches of the plan lie (the end of a sub-step that holds
+ * them): midway between switch n_max and the next (T when there are no more). */
+double fesd__plan_cut(fesd_integrator *it, int n_max);
+
+/* ---- accept.c ---- */
 int fesd__accept(fesd_integrator *it, const double *z, const double *u, double T);
+/* Element records for need elements (create: one largest layout; more only for a step with
+ * sub-steps or halvings beyond that). */
+int fesd__grow_records(fesd_integrator *it, int need);
+
 #endif

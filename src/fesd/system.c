@@ -6,7 +6,7 @@
 void fesd__system_free(fesd__system *S) {
   if (!S) return;
   if (S->pe) {
-    int np = S->N * S->s + S->N;
+    int np = S->N_cap * S->s + S->N_cap;
     for (int p = 0; p < np; p++) fesd__point_free(&S->pe[p]);
   }
   free(S->pe);
@@ -17,8 +17,6 @@ void fesd__system_free(fesd__system *S) {
   free(S->rel);
   free(S->rlb);
   free(S->rx);
-  free(S->prow);
-  free(S->pcol);
   free(S->X);
   free(S->Jth);
   free(S->JK);
@@ -26,6 +24,11 @@ void fesd__system_free(fesd__system *S) {
   free(S->Juth);
   free(S->lam00_dp);
   free(S->tmp);
+  free(S->wraw);
+  free(S->wG);
+  double *mags[] = {S->magX, S->magV, S->magG, S->refX, S->refV, S->refG};
+  for (int q = 0; q < 6; q++) free(mags[q]);
+  free(S->wth);
   memset(S, 0, sizeof(*S));
 }
 
@@ -56,7 +59,7 @@ double fesd__cross_value(const fesd__system *S, const double *z, int n) {
       Lt += la;
       diag += th * la;
     }
-    c += Th * Lt - diag;
+    c += S->wth[i] * (Th * Lt - diag);
   }
   return c;
 }
@@ -78,26 +81,28 @@ enum { EMIT_COUNT, EMIT_PATTERN, EMIT_VALUES };
       (E)->row[(E)->k] = (r);          \
       (E)->col[(E)->k] = (c);          \
     } else if (mode == EMIT_VALUES) {  \
-      (E)->val[(E)->k] = (expr);       \
+      (E)->val[(E)->k] = (expr) * wr[r]; \
     }                                  \
     (E)->k++;                          \
   } while (0)
 
-/* Entries of the indicator Jacobian block of every subsystem: (row, state column, value). */
+/* Entries of the indicator Jacobian block of every subsystem: (row, state column, value),
+ * each row weighted by its subsystem's indicator weight. */
 #define EMIT_DG(E, rowbase, colbase, blkptr, scale)                                  \
   for (int kk = 0; kk < m->nsys; kk++) {                                            \
     const int nfk = m->nf[kk], off = m->th_off[kk];                                 \
     for (int cp = 0; cp < m->ncol[kk]; cp++)                                        \
       for (int li = 0; li < nfk; li++)                                              \
         EMIT(E, (rowbase) + off + li, (colbase) + m->cols[kk][cp],                  \
-             (scale) * (blkptr)[m->dgoff[kk] + (size_t)cp * nfk + li]);             \
+             (scale) * (blkptr)[m->dgoff[kk] + (size_t)cp * nfk + li]); \
   }
 
 static inline __attribute__((always_inline)) void emit_body(const fesd__system *S, const double *z, emitter *E,
                                                             const int mode) {
-  const int N = S->N, s = S->s, nx = S->nx, nth = S->nth, nsys = S->nsys;
+  const int N = S->N, s = S->s, nx = S->nx, nth = S->nth;
   const fesd__model *m = S->model;
   const int values = mode == EMIT_VALUES;
+  const double *wth = S->wth, *wr = S->wraw; /* row weights; cross-complementarity terms */
   for (int n = 0; n < N; n++) {
     const double h = values ? z[S->ho[n]] : 0;
     for (int j = 0; j < s; j++) {
@@ -110,10 +115,12 @@ static inline __attribute__((always_inline)) void emit_body(const fesd__system *
         const double a = S->tab.A[j][l];
         if (j == l)
           for (int r = 0; r < nx; r++) EMIT(E, rV + r, fesd__v(S, n, l) + r, 1.0);
-        for (int q = 0; q < m->pf_nnz; q++) EMIT(E, rV + m->pf_r[q], fesd__v(S, n, l) + m->pf_c[q], -h * a * J[q]);
+        for (int q = 0; q < m->pf_nnz; q++)
+          EMIT(E, rV + m->pf_r[q], fesd__v(S, n, l) + m->pf_c[q], -h * a * J[q]);
       }
       if (n > 0)
-        for (int q = 0; q < m->pf_nnz; q++) EMIT(E, rV + m->pf_r[q], S->xo[n - 1] + m->pf_c[q], -J[q]);
+        for (int q = 0; q < m->pf_nnz; q++)
+          EMIT(E, rV + m->pf_r[q], S->xo[n - 1] + m->pf_c[q], -J[q]);
       for (int r = 0; r < nx; r++) EMIT(E, rV + r, S->ho[n], -JK[r]); /* d/dh: -J K_j */
       for (int i = 0; i < nth; i++) {
         const int k = m->sys_of[i];
@@ -159,7 +166,6 @@ static inline __attribute__((always_inline)) void emit_body(const fesd__system *
       for (int j = 0; j < s; j++) EMIT(E, rX + r, fesd__v(S, n, j) + r, -h * S->tab.b[j]);
     }
   }
-  (void)nsys;
   /* boundary rows */
   for (int k = 1; k < N; k++) {
     EMIT(E, fesd__rowH(S, k), S->ho[k], 1.0);
@@ -177,15 +183,16 @@ static inline __attribute__((always_inline)) void emit_body(const fesd__system *
             Lt += z[fesd__la(S, n, j) + i];
           }
         }
+        const double w = values ? wth[i] : 0;
         for (int j = 0; j < s; j++) {
-          EMIT(E, rC, fesd__th(S, n, j) + i, Lt - z[fesd__la(S, n, j) + i]);
-          EMIT(E, rC, fesd__la(S, n, j) + i, Th - z[fesd__th(S, n, j) + i]);
+          EMIT(E, rC, fesd__th(S, n, j) + i, w * (Lt - z[fesd__la(S, n, j) + i]));
+          EMIT(E, rC, fesd__la(S, n, j) + i, w * (Th - z[fesd__th(S, n, j) + i]));
         }
         if (n > 0) {
           int col = S->bp ? S->lbo[n - 1] + i : fesd__la(S, n - 1, s - 1) + i;
-          EMIT(E, rC, col, Th);
+          EMIT(E, rC, col, w * Th);
         }
-        if (S->bp && S->lbo[n] >= 0) EMIT(E, rC, S->lbo[n] + i, Th);
+        if (S->bp && S->lbo[n] >= 0) EMIT(E, rC, S->lbo[n] + i, w * Th);
       }
     }
   }
@@ -214,20 +221,38 @@ static void emit_values(const fesd__system *S, const double *z, double *val) {
   emit_body(S, z, &E, EMIT_VALUES);
 }
 
-int fesd__system_init(fesd__system *S, fesd__model *m, const fesd_tableau *tab, int N, int sens) {
+void fesd__system_set_N(fesd__system *S, int N) {
+  S->N = N;
+  S->n = N * S->eb;
+  const int row = N * S->erows;
+  S->rH0 = row;
+  S->rC0 = row + (N - 1);
+  S->rT = row + 2 * (N - 1);
+  S->n_eq = S->rT + 1;
+  S->n_pair = N * S->s * S->nth;
+  S->n_raw = S->n_eq + 2 * S->n_pair;
+  S->nnz = emit_count(S);
+}
+
+int fesd__system_nnz(const fesd__system *S) { return S->nnz; }
+void fesd__system_pattern(const fesd__system *S, int *row, int *col) { emit_pattern(S, row, col); }
+
+int fesd__system_init(fesd__system *S, fesd__model *m, const fesd_tableau *tab, int N_cap, int sens) {
   memset(S, 0, sizeof(*S));
   S->model = m;
   S->tab = *tab;
-  S->N = N;
+  S->N_cap = N_cap;
   S->s = tab->s;
   S->nx = m->nx;
   S->nth = m->nth;
   S->nsys = m->nsys;
   S->nu = m->nu;
   S->bp = !tab->stiffly_accurate;
-  const int s = S->s, nx = S->nx, nth = S->nth, nsys = S->nsys, nu = S->nu;
+  const int s = S->s, nx = S->nx, nth = S->nth, nsys = S->nsys, nu = S->nu, N = N_cap;
   S->sb = nx + 2 * nth + nsys;
   S->rs = nx + nth + nsys;
+  S->eb = s * S->sb + (S->bp ? nth + nsys : 0) + nx + 1;
+  S->erows = s * S->rs + (S->bp ? nth + nsys : 0) + nx;
   S->el = malloc((size_t)N * sizeof(int));
   S->xo = malloc((size_t)N * sizeof(int));
   S->ho = malloc((size_t)N * sizeof(int));
@@ -235,7 +260,19 @@ int fesd__system_init(fesd__system *S, fesd__model *m, const fesd_tableau *tab, 
   S->rel = malloc((size_t)N * sizeof(int));
   S->rlb = malloc((size_t)N * sizeof(int));
   S->rx = malloc((size_t)N * sizeof(int));
-  if (!S->el || !S->xo || !S->ho || !S->lbo || !S->rel || !S->rlb || !S->rx) goto nomem;
+  S->wG = malloc((size_t)nsys * sizeof(double));
+  S->magX = calloc((size_t)nx, sizeof(double));
+  S->magV = calloc((size_t)nx, sizeof(double));
+  S->refX = calloc((size_t)nx, sizeof(double));
+  S->refV = calloc((size_t)nx, sizeof(double));
+  S->magG = calloc((size_t)nsys, sizeof(double));
+  S->refG = calloc((size_t)nsys, sizeof(double));
+  S->wth = malloc((size_t)nth * sizeof(double));
+  if (!S->el || !S->xo || !S->ho || !S->lbo || !S->rel || !S->rlb || !S->rx || !S->wG || !S->wth ||
+      !S->magX || !S->magV || !S->refX || !S->refV || !S->magG || !S->refG)
+    goto nomem;
+  for (int k = 0; k < nsys; k++) S->wG[k] = 1.0;
+  for (int i = 0; i < nth; i++) S->wth[i] = 1.0;
   int off = 0, row = 0;
   for (int n = 0; n < N; n++) {
     S->el[n] = off;
@@ -257,13 +294,6 @@ int fesd__system_init(fesd__system *S, fesd__model *m, const fesd_tableau *tab, 
     S->ho[n] = off;
     off += 1;
   }
-  S->n = off;
-  S->rH0 = row;
-  S->rC0 = row + (N - 1);
-  S->rT = row + 2 * (N - 1);
-  S->n_eq = S->rT + 1;
-  S->n_pair = N * s * nth;
-  S->n_raw = S->n_eq + 2 * S->n_pair;
   int np = N * s + N;
   size_t nu1 = (size_t)(nu > 0 ? nu : 1), pf = (size_t)(m->pf_nnz > 0 ? m->pf_nnz : 1);
   S->pe = calloc((size_t)np, sizeof(*S->pe));
@@ -273,17 +303,15 @@ int fesd__system_init(fesd__system *S, fesd__model *m, const fesd_tableau *tab, 
   S->KG = malloc((size_t)N * s * nth * sizeof(double));
   S->Juth = malloc((size_t)N * s * nx * nu1 * sizeof(double));
   S->lam00_dp = malloc((sens ? (size_t)nth * (nx + nu) : 1) * sizeof(double)); /* O(n^2) */
-  S->tmp = malloc((size_t)(2 * nx + nth) * sizeof(double));
+  S->tmp = malloc((size_t)(4 * nx + nth) * sizeof(double));
   if (!S->pe || !S->X || !S->Jth || !S->JK || !S->KG || !S->Juth || !S->lam00_dp || !S->tmp)
     goto nomem;
   for (int p = 0; p < np; p++)
     if (fesd__point_alloc(m, &S->pe[p], p < N * s)) goto nomem;
-  /* pattern: count, then record */
-  S->nnz = emit_count(S);
-  S->prow = malloc((size_t)S->nnz * sizeof(int));
-  S->pcol = malloc((size_t)S->nnz * sizeof(int));
-  if (!S->prow || !S->pcol) goto nomem;
-  emit_pattern(S, S->prow, S->pcol);
+  fesd__system_set_N(S, N_cap);
+  S->wraw = malloc((size_t)S->n_raw * sizeof(double));
+  if (!S->wraw) goto nomem;
+  for (int r = 0; r < S->n_raw; r++) S->wraw[r] = 1.0;
   return FESD_OK;
 nomem:
   fesd__system_free(S);
@@ -291,7 +319,7 @@ nomem:
 }
 
 /* Evaluate the model at every stage point (and boundary point) of z. */
-static int eval_points(fesd__system *S, const double *z, int want_jac) {
+int fesd__system_points(fesd__system *S, const double *z, int want_jac) {
   const int N = S->N, s = S->s, nx = S->nx, nth = S->nth, nu = S->nu;
   fesd__model *m = S->model;
   double *K = S->tmp; /* K_j = sum_l a_jl v_l */
@@ -347,7 +375,7 @@ int fesd__system_eval(const double *z, double *raw, double *jac, void *ctx) {
   fesd__system *S = ctx;
   const int N = S->N, s = S->s, nx = S->nx, nth = S->nth, nsys = S->nsys;
   const fesd__model *m = S->model;
-  int st = eval_points(S, z, jac != NULL);
+  int st = fesd__system_points(S, z, jac != NULL);
   S->status = st;
   if (st) return 1;
   for (int n = 0; n < N; n++) {
@@ -395,6 +423,7 @@ int fesd__system_eval(const double *z, double *raw, double *jac, void *ctx) {
         raw[S->n_eq + p] = z[fesd__th(S, n, j) + i];
         raw[S->n_eq + S->n_pair + p] = z[fesd__la(S, n, j) + i];
       }
+  for (int r = 0; r < S->n_raw; r++) raw[r] *= S->wraw[r];
   if (jac) emit_values(S, z, jac);
   return 0;
 }
@@ -409,7 +438,8 @@ int fesd__system_param_jac(fesd__system *S, const double *z, double *out) {
     const double *J = S->Jth + (size_t)j * m->pf_nnz;
     const fesd__point_eval *pe = &S->pe[j];
     const int rV = S->rel[0] + j * S->rs, rG = rV + nx;
-    for (int q = 0; q < m->pf_nnz; q++) out[(size_t)m->pf_c[q] * ld + rV + m->pf_r[q]] -= J[q];
+    for (int q = 0; q < m->pf_nnz; q++)
+      out[(size_t)m->pf_c[q] * ld + rV + m->pf_r[q]] -= J[q];
     for (int k = 0; k < m->nsys; k++)
       for (int cp = 0; cp < m->ncol[k]; cp++)
         for (int li = 0; li < m->nf[k]; li++)
@@ -444,8 +474,10 @@ int fesd__system_param_jac(fesd__system *S, const double *z, double *out) {
     for (int i = 0; i < nth; i++) {
       double Th = 0;
       for (int j = 0; j < s; j++) Th += z[fesd__th(S, 0, j) + i];
-      for (int c = 0; c < np; c++) out[(size_t)c * ld + rC] += Th * S->lam00_dp[c * nth + i];
+      for (int c = 0; c < np; c++) out[(size_t)c * ld + rC] += S->wth[i] * Th * S->lam00_dp[c * nth + i];
     }
   }
+  for (int c = 0; c < np; c++)
+    for (int r = 0; r < S->n_raw; r++) out[(size_t)c * ld + r] *= S->wraw[r];
   return FESD_OK;
 }

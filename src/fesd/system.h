@@ -17,7 +17,16 @@
  * complementarity, eq. cross_comp); last T: sum h - T.
  * Pairs: (theta_{n,j,i}, lambda_{n,j,i}).
  * The solver's row selection chooses, per boundary, H or C (or neither at a
- * pinned sliding exit, where the pair of the dropping mode is PIN). */
+ * pinned sliding exit, where the pair of the dropping mode is PIN).
+ *
+ * The number of elements N varies from step to step (a step gets one boundary per switch
+ * it holds): storage is for N_cap elements, fesd__system_set_N() selects the layout of N
+ * (element blocks are the same for every N; only the boundary rows and counts move).
+ *
+ * Row weights: every raw row is multiplied by wraw (1 / the size of the terms it compares,
+ * weights.c), so that tolerances are relative and results do not depend on units or on how
+ * far time has run. The cross-complementarity rows weight each mode's products by wth (1 /
+ * the indicator scale of its subsystem): dimensionless, whatever the subsystems' units. */
 #ifndef FESD_SYSTEM_H
 #define FESD_SYSTEM_H
 
@@ -25,19 +34,17 @@
 #include "fesd_rk.h"
 
 typedef struct {
-  int N, s, nx, nth, nsys, nu, bp;
+  int N, N_cap, s, nx, nth, nsys, nu, bp;
   fesd_tableau tab;
   fesd__model *model;
-  /* variable layout */
-  int sb, n;
+  /* variable layout (eb unknowns and erows rows per element) */
+  int sb, n, eb, erows;
   int *el, *xo, *ho, *lbo;
   /* row layout */
   int rs; /* rows per stage */
   int *rel, *rlb, *rx;
   int rH0, rC0, rT, n_eq, n_pair, n_raw;
-  /* pattern */
-  int nnz;
-  int *prow, *pcol;
+  int nnz; /* Jacobian entries of the current layout */
   /* parameters of the current step */
   const double *x0, *u, *lam00;
   double T;
@@ -50,12 +57,24 @@ typedef struct {
   double *KG;   /* grad g_i . K_j per stage point (nth) */
   double *Juth; /* sum_i theta_i dF_i/du per stage point, N*s blocks nx x nu */
   double *lam00_dp; /* d lambda00 / d(x_start, u): nth x (nx + nu) */
-  double *tmp;  /* 2 nx + nth */
+  double *tmp;  /* 4 nx + nth */
+  /* row weights (n_raw of the largest layout), indicator weights per subsystem (wG) and
+   * per stacked mode (wth = wG of its subsystem) */
+  double *wraw, *wG, *wth;
+  /* sizes at the last weighting (per state component: X rows, V rows; per subsystem: the
+   * indicators), and their maxima over the accepted steps (weights.c) */
+  double *magX, *magV, *magG, *refX, *refV, *refG;
   int status;   /* last model status */
 } fesd__system;
 
-/* sens: allocate the parameter-derivative storage of sensitivities (O(nth (nx + nu))) */
-int fesd__system_init(fesd__system *S, fesd__model *m, const fesd_tableau *tab, int N, int sens);
+/* Storage for up to N_cap elements (the layout starts with N = N_cap); sens: allocate the
+ * parameter-derivative storage of sensitivities (O(nth (nx + nu))). Weights start at 1. */
+int fesd__system_init(fesd__system *S, fesd__model *m, const fesd_tableau *tab, int N_cap, int sens);
+/* Layout of N <= N_cap elements (counts and boundary-row offsets). */
+void fesd__system_set_N(fesd__system *S, int N);
+/* Jacobian pattern entries of the current layout, and the pattern itself (row, col). */
+int fesd__system_nnz(const fesd__system *S);
+void fesd__system_pattern(const fesd__system *S, int *row, int *col);
 void fesd__system_free(fesd__system *S);
 
 /* Offsets. */
@@ -77,6 +96,16 @@ static inline int fesd__pair(const fesd__system *S, int n, int j, int i) {
 const double *fesd__right_lambda(const fesd__system *S, const double *z, int n);
 /* Left-boundary lambda of element n (lambda00 for n == 0). */
 const double *fesd__left_lambda(const fesd__system *S, const double *z, int n);
+
+/* Evaluate the model at every stage point (and boundary LP point) of z, with Jacobians when
+ * want_jac (fills pe, X, Jth, JK, KG). */
+int fesd__system_points(fesd__system *S, const double *z, int want_jac);
+/* Row weights at z (weights.c): 1 / the size of the terms of each row at z. */
+int fesd__system_weights(fesd__system *S, const double *z);
+/* Forget the reference sizes (a new initial state); fold the sizes of the last weighting (an
+ * accepted solution) into them. */
+void fesd__system_reset_refs(fesd__system *S);
+void fesd__system_update_refs(fesd__system *S);
 
 /* ncp callback: raw residual and Jacobian values (ctx = fesd__system). */
 int fesd__system_eval(const double *z, double *raw, double *jac, void *ctx);

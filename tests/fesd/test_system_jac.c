@@ -1,6 +1,7 @@
 /* The step system's analytic Jacobian (and parameter Jacobian) against central finite
  * differences of its own residual, for several models and RK families (stiffly accurate
- * and boundary-point methods), at random points. Independent of the solver. */
+ * and boundary-point methods), at random points, with random row weights and a layout of
+ * fewer elements than the storage holds. Independent of the solver. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -24,11 +25,17 @@ static int check(const char *prob, fesd_rk_family fam, int s, int N) {
   fesd__system S;
   fesd_tableau tab;
   if (fesd__model_init(&M, &P.model) || fesd_tableau_get(fam, s, &tab) ||
-      fesd__system_init(&S, &M, &tab, N, 1)) {
+      fesd__system_init(&S, &M, &tab, N + 2, 1)) {
     printf("FAIL setup %s\n", prob);
     return 1;
   }
+  fesd__system_set_N(&S, N);
+  for (int r = 0; r < S.n_raw; r++) S.wraw[r] = 0.5 + urand();
+  for (int k = 0; k < S.nsys; k++) S.wG[k] = 0.2 + 2 * urand();
+  for (int i = 0; i < S.nth; i++) S.wth[i] = S.wG[M.sys_of[i]];
   const int n = S.n, nr = S.n_raw, np = S.nx + S.nu;
+  int *prow = malloc(S.nnz * sizeof(int)), *pcol = malloc(S.nnz * sizeof(int));
+  fesd__system_pattern(&S, prow, pcol);
   double *z = malloc(n * sizeof(double)), *zp = malloc(n * sizeof(double));
   double *raw = malloc(nr * sizeof(double)), *r1 = malloc(nr * sizeof(double)),
          *r2 = malloc(nr * sizeof(double));
@@ -46,7 +53,7 @@ static int check(const char *prob, fesd_rk_family fam, int s, int N) {
   S.want_u = 1;
   memset(S.lam00_dp, 0, (size_t)S.nth * np * sizeof(double));
   fesd__system_eval(z, raw, jac, &S);
-  for (int k = 0; k < S.nnz; k++) J[(size_t)S.pcol[k] * nr + S.prow[k]] += jac[k];
+  for (int k = 0; k < S.nnz; k++) J[(size_t)pcol[k] * nr + prow[k]] += jac[k];
   fesd__system_param_jac(&S, z, dp);
   double worst = 0, worstp = 0;
   for (int c = 0; c < n; c++) {
@@ -76,7 +83,7 @@ static int check(const char *prob, fesd_rk_family fam, int s, int N) {
   int fail = worst > 1e-6 || worstp > 1e-6;
   printf("%s %-12s %-9s s=%d N=%d n=%4d nnz=%5d: max rel err jac %.2e, param jac %.2e\n",
          fail ? "FAIL" : "ok  ", prob, fesd_rk_family_name(fam), s, N, n, S.nnz, worst, worstp);
-  free(z), free(zp), free(raw), free(r1), free(r2), free(jac), free(J), free(dp);
+  free(z), free(zp), free(raw), free(r1), free(r2), free(jac), free(J), free(dp), free(prow), free(pcol);
   fesd__system_free(&S);
   fesd__model_free(&M);
   return fail;

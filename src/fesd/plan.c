@@ -1,0 +1,289 @@
+/* The switch plan of a step: which subsystem switches to which active set at which
+ * (predicted) time. Every switch gets an element boundary of its own, with the binding row of
+ * Theorem 3 (cross complementarity; a pinned exit for a mode leaving a sliding mode) and
+ * equal element lengths elsewhere, so one smooth solve resolves all the switches of a step:
+ * of one subsystem or of many, at different times. Switches of different subsystems at the
+ * same instant share one boundary, whose cross-complementarity row then vanishes only when
+ * all of them hold (its derivative in the boundary time is the sum of theirs).
+ *
+ * A solve whose solution still violates a sign changes the plan (plan_update): a violation
+ * right after a switch of its subsystem means that switch chose the wrong modes (a crossing
+ * that should slide, a sliding mode that Filippov's conditions reject, a second mode joining
+ * at a corner), any other adds a switch at its predicted time and drops the later switches
+ * of that subsystem (they were predicted with the wrong modes). */
+#include <math.h>
+#include <string.h>
+
+#include "fesd/step.h"
+
+/* Active sets tried after one switch before the plan gives up on it. */
+#define MAX_TRIES 4
+/* A switch predicted this close to the step start (fraction of T) happens at the start. */
+#define AT_START 1e-9
+
+void fesd__plan_reset(fesd_integrator *it) {
+  it->n_plan = 0;
+  it->merge_tol = 1e-9;
+}
+
+static unsigned char *after(fesd_integrator *it, int e) { return it->plan_after + (size_t)e * it->nth; }
+
+static void swap_switch(fesd_integrator *it, int a, int b) {
+  fesd__switch t = it->plan[a];
+  it->plan[a] = it->plan[b];
+  it->plan[b] = t;
+  unsigned char *pa = after(it, a), *pb = after(it, b), *tmp = it->swap_set;
+  memcpy(tmp, pa, (size_t)it->nth);
+  memcpy(pa, pb, (size_t)it->nth);
+  memcpy(pb, tmp, (size_t)it->nth);
+}
+
+static void remove_switch(fesd_integrator *it, int e) {
+  for (int q = e; q + 1 < it->n_plan; q++) swap_switch(it, q, q + 1);
+  it->n_plan--;
+}
+
+/* Drop the switches of subsystem k after time t. */
+static void drop_after(fesd_integrator *it, int k, double t) {
+  for (int e = it->n_plan - 1; e >= 0; e--)
+    if (it->plan[e].sys == k && it->plan[e].t > t) remove_switch(it, e);
+}
+
+void fesd__plan_truncate(fesd_integrator *it, double t) {
+  for (int e = it->n_plan - 1; e >= 0; e--)
+    if (it->plan[e].t >= t) remove_switch(it, e);
+}
+
+static void sort_plan(fesd_integrator *it) {
+  for (int a = 1; a < it->n_plan; a++)
+    for (int b = a; b > 0 && it->plan[b].t < it->plan[b - 1].t; b--) swap_switch(it, b, b - 1);
+}
+
+/* Boundaries of the sorted plan: clusters of entering switches of different subsystems within
+ * merge_tol T share one; an exit has its own. Writes bt[1..nb] and returns nb. */
+static int cluster(fesd_integrator *it, double T, int *first_of) {
+  int nb = 0;
+  for (int e = 0; e < it->n_plan; e++) {
+    const fesd__switch *w = &it->plan[e];
+    int join = 0;
+    if (nb > 0 && !w->exit) {
+      const int f = first_of[nb - 1];
+      join = !it->plan[f].exit && w->t - it->plan[f].t <= it->merge_tol * T;
+      for (int q = f; q < e && join; q++) join = it->plan[q].sys != w->sys && !it->plan[q].exit;
+    }
+    if (!join) {
+      first_of[nb] = e;
+      it->bt[++nb] = w->t;
+    }
+    it->plan[e].kb = nb; /* cluster index for now; element boundary below */
+  }
+  return nb;
+}
+
+int fesd__plan_layout(fesd_integrator *it, double T, double *z) {
+  fesd__system *S = &it->sys;
+  const int nth = it->nth, s = it->s;
+  sort_plan(it);
+  int *first_of = it->kb;
+  const int nb = cluster(it, T, first_of);
+  if (nb + 1 > it->N_cap) return FESD_ERR_TOO_MANY_SWITCHES;
+  const int N = fesd__ladder(it, nb + 1 > it->set.n_fe ? nb + 1 : it->set.n_fe);
+  int st = fesd__use_level(it, N);
+  if (st) return st;
+  /* boundary times strictly increasing inside (0, T) */
+  double *bt = it->bt;
+  const double gap = 1e-8 * T;
+  bt[0] = 0;
+  bt[nb + 1] = T;
+  for (int q = 1; q <= nb; q++) {
+    if (bt[q] < bt[q - 1] + gap) bt[q] = bt[q - 1] + gap;
+    if (bt[q] > T - (nb + 1 - q) * gap) bt[q] = T - (nb + 1 - q) * gap;
+  }
+  /* elements per segment: one each, the rest to the segment with the longest elements */
+  int *cnt = it->bseg;
+  for (int q = 0; q <= nb; q++) cnt[q] = 1;
+  for (int extra = N - (nb + 1); extra > 0; extra--) {
+    int best = 0;
+    for (int q = 1; q <= nb; q++)
+      if ((bt[q + 1] - bt[q]) * cnt[best] > (bt[best + 1] - bt[best]) * cnt[q]) best = q;
+    cnt[best]++;
+  }
+  /* active sets, boundary rows and element lengths */
+  unsigned char *cur = it->cand;
+  memcpy(cur, it->act0, (size_t)nth);
+  memset(it->bmode, 0, (size_t)(N + 1) * sizeof(int));
+  int n = 0, e = 0;
+  for (int q = 0; q <= nb; q++) {
+    if (q > 0) {
+      for (; e < it->n_plan && it->plan[e].kb == q; e++) {
+        fesd__switch *w = &it->plan[e];
+        const int a = it->model.th_off[w->sys], b = it->model.th_off[w->sys + 1];
+        memcpy(cur + a, after(it, e) + a, (size_t)(b - a));
+        it->bmode[n] = w->exit ? 2 : 1;
+        it->exit_mode[n] = w->mode;
+        w->kb = n;
+      }
+    }
+    for (int c = 0; c < cnt[q]; c++, n++) {
+      for (int j = 0; j < s; j++) memcpy(it->act + (size_t)(n * s + j) * nth, cur, (size_t)nth);
+      z[S->ho[n]] = (bt[q + 1] - bt[q]) / cnt[q];
+    }
+  }
+  return FESD_OK;
+}
+
+void fesd__plan_times(fesd_integrator *it, const double *z) {
+  const fesd__system *S = &it->sys;
+  for (int e = 0; e < it->n_plan; e++) {
+    double t = 0;
+    for (int n = 0; n < it->plan[e].kb; n++) t += z[S->ho[n]];
+    it->plan[e].t = t;
+  }
+}
+
+double fesd__plan_cut(fesd_integrator *it, int n_max) {
+  sort_plan(it);
+  if (it->n_plan <= n_max) return it->sys.T;
+  const double ta = n_max > 0 ? it->plan[n_max - 1].t : 0.0, tb = it->plan[n_max].t;
+  return 0.5 * (ta + tb);
+}
+
+/* The active set of subsystem k just before time t: the start set or the set after its
+ * latest switch before t; *e_out: that switch (-1: the start). */
+static const unsigned char *set_before(fesd_integrator *it, int k, double t, int *e_out) {
+  int best = -1;
+  for (int e = 0; e < it->n_plan; e++)
+    if (it->plan[e].sys == k && it->plan[e].t <= t && (best < 0 || it->plan[e].t >= it->plan[best].t)) best = e;
+  *e_out = best;
+  return best < 0 ? it->act0 : after(it, best);
+}
+
+/* Entering mode j next to the set P of subsystem k at time t of the solution z: a crossing
+ * (j alone) when j's field points into j's region, else a sliding mode (P and j). */
+static int enter_set(fesd_integrator *it, const double *z, double t, int k, const unsigned char *P, int j,
+                     unsigned char *out) {
+  const fesd__model *m = &it->model;
+  int n_act = 0, i_old = -1;
+  for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++)
+    if (P[i]) n_act++, i_old = i;
+  int cross = 0;
+  if (n_act == 1) {
+    fesd__system *S = &it->sys;
+    double *x = it->gbuf + it->nth;
+    fesd__state_at(it, z, S->N, t, x);
+    fesd__point_eval pe = {0};
+    pe.F = it->pscr.F;
+    pe.g = it->pscr.g;
+    pe.dgdx = it->pscr.dgdx;
+    int st = fesd__model_eval(&it->model, x, S->u, &pe);
+    if (st) return st;
+    /* thetas of the other subsystems: the stage nearest before t */
+    double tn = 0;
+    int n = 0;
+    while (n + 1 < S->N && t >= tn + z[S->ho[n]]) tn += z[S->ho[n++]];
+    double ai, aj;
+    fesd__normal_components(it, &pe, z + fesd__th(S, n, 0), i_old, j, &ai, &aj);
+    cross = aj > 0;
+  }
+  for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) out[i] = cross ? i == j : (P[i] || i == j);
+  return FESD_OK;
+}
+
+static int empty_set(const fesd_integrator *it, const unsigned char *a, int k) {
+  for (int i = it->model.th_off[k]; i < it->model.th_off[k + 1]; i++)
+    if (a[i]) return 0;
+  return 1;
+}
+
+/* Exits are pinned only by stiffly accurate methods with exit rows (otherwise the FB path). */
+static int can_pin_exit(const fesd_integrator *it) { return it->set.exit_rows && !it->sys.bp; }
+
+/* A switch at the step start: the start set of k changes (the saltation of the sensitivities
+ * is applied explicitly, accept.c). */
+static void start_jump(fesd_integrator *it, int k, const unsigned char *newset) {
+  const fesd__model *m = &it->model;
+  int in = -1, out = -1;
+  for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) {
+    if (newset[i] && !it->act0[i] && in < 0) in = i;
+    if (!newset[i] && it->act0[i] && out < 0) out = i;
+  }
+  if (in >= 0 && out >= 0) {
+    it->jump_in[k] = in;
+    it->jump_out[k] = out;
+  }
+  memcpy(it->act0 + m->th_off[k], newset + m->th_off[k], (size_t)(m->th_off[k + 1] - m->th_off[k]));
+}
+
+static int update_one(fesd_integrator *it, const double *z, const fesd__violation *v, double T) {
+  const fesd__model *m = &it->model;
+  const int k = v->sys, a = m->th_off[k], b = m->th_off[k + 1];
+  unsigned char *ns = it->cand; /* new set of subsystem k (slice a..b used) */
+  int e;
+  const unsigned char *P = set_before(it, k, v->t, &e);
+  if (v->filippov) {
+    /* not a sliding mode: the mode whose field points into its own region continues */
+    if (v->filippov < 0) it->nonunique = 1;
+    memset(ns + a, 0, (size_t)(b - a));
+    ns[v->mode] = 1;
+    if (e < 0) {
+      start_jump(it, k, ns);
+      drop_after(it, k, -1.0);
+      return 1;
+    }
+    if (++it->plan[e].tries > MAX_TRIES || !memcmp(after(it, e) + a, ns + a, (size_t)(b - a))) return 0;
+    memcpy(after(it, e) + a, ns + a, (size_t)(b - a));
+    drop_after(it, k, it->plan[e].t);
+    return 1;
+  }
+  if (v->first && e >= 0) {
+    /* the switch before chose the wrong modes: add the mode that wants in, drop the one
+     * that wants out */
+    fesd__switch *w = &it->plan[e];
+    unsigned char *A = after(it, e);
+    if (++w->tries > MAX_TRIES || A[v->mode] == (unsigned char)v->enter) return 0;
+    A[v->mode] = (unsigned char)v->enter;
+    if (empty_set(it, A, k)) return 0;
+    drop_after(it, k, w->t);
+    return 1;
+  }
+  /* a new switch at the predicted time */
+  drop_after(it, k, v->t);
+  P = set_before(it, k, v->t, &e);
+  if (v->enter) {
+    int st = enter_set(it, z, v->t, k, P, v->mode, ns);
+    if (st) return st;
+  } else {
+    if (!can_pin_exit(it)) return 0;
+    memcpy(ns + a, P + a, (size_t)(b - a));
+    ns[v->mode] = 0;
+    if (empty_set(it, ns, k)) return 0;
+  }
+  if (v->t <= AT_START * T && e < 0) {
+    start_jump(it, k, ns);
+    return 1;
+  }
+  if (it->n_plan >= it->cap_plan) return FESD_ERR_TOO_MANY_SWITCHES;
+  fesd__switch *w = &it->plan[it->n_plan];
+  w->t = v->t;
+  w->sys = k;
+  w->mode = v->mode;
+  w->exit = !v->enter;
+  w->kb = -1;
+  w->tries = 0;
+  memcpy(after(it, it->n_plan) + a, ns + a, (size_t)(b - a));
+  it->n_plan++;
+  return 1;
+}
+
+int fesd__plan_update(fesd_integrator *it, const double *z, const fesd__violation *per_sys) {
+  const double T = it->sys.T;
+  int changed = 0;
+  for (int k = 0; k < it->nsys; k++) {
+    if (!per_sys[k].found) continue;
+    int r = update_one(it, z, &per_sys[k], T);
+    if (r < 0) return r;
+    if (r == 0) return 0;
+    changed = 1;
+  }
+  return changed;
+}

@@ -1,0 +1,369 @@
+/* Checks of a converged step solution against what it claims. With the active sets fixed
+ * the step system is smooth, so a converged solution still has to show that:
+ *  - the signs hold at every point the equations see: theta >= 0 on active modes, lambda >= 0
+ *    on inactive ones (stage points, boundary LP points);
+ *  - between the stage points the collocation polynomial stays in the regions of its active
+ *    modes (cross complementarity only sees the stage points: a short excursion, or the many
+ *    switches of a Zeno accumulation, pass through an element unseen);
+ *  - a 2-mode sliding mode is one in Filippov's sense: the fields of both modes point towards
+ *    the surface. The discrete sliding equations also have spurious solutions: a long element
+ *    whose stage points all lie on the surface (or at a point where both normal components
+ *    vanish) while the polynomial between them crosses it (measured: a bang-bang oscillator
+ *    with two crossings in one step collapsed to the origin as a "sliding mode").
+ * A violation locates the next switch: lambda of an inactive mode is a smooth difference of
+ * indicators along the computed trajectory, theta of an active mode a smooth sliding
+ * multiplier, so their linear zero crossing predicts the switch time.
+ * Tolerances are relative: lambda in units of its subsystem's indicator scale (system.h). */
+#include <math.h>
+#include <string.h>
+
+#include "fesd/step.h"
+
+/* Filippov check: normal components of the same sign whose smaller one exceeds this fraction
+ * of the larger one at a stage point (a field clearly pointing away from the surface)... */
+#define FIL_STAGE_TOL 1e-4
+/* ...and at the midpoints between stage points, where the polynomial is an interpolant
+ * (only a clear crossing counts there). */
+#define FIL_MID_TOL 0.1
+/* Interpolation allowance of the midpoint region check, in units of cc_tol. */
+#define INTERIOR_TOL 1e3
+
+int fesd__collocation(const fesd_integrator *it) {
+  const int f = it->tab.family;
+  return f == FESD_RK_RADAU_IIA || f == FESD_RK_GAUSS_LEGENDRE || f == FESD_RK_LOBATTO_IIIA;
+}
+
+void fesd__interior_setup(fesd_integrator *it) {
+  const fesd_tableau *T = &it->tab;
+  double nodes[FESD_RK_MAX_STAGES + 2];
+  int nn = 0;
+  nodes[nn++] = 0.0;
+  for (int j = 0; j < T->s; j++)
+    if (T->c[j] > nodes[nn - 1]) nodes[nn++] = T->c[j];
+  if (nodes[nn - 1] < 1.0) nodes[nn++] = 1.0;
+  it->n_mid = nn - 1;
+  for (int p = 0; p + 1 < nn; p++) {
+    it->mid_tau[p] = 0.5 * (nodes[p] + nodes[p + 1]);
+    fesd__colloc_weights(it, it->mid_tau[p], it->mid_w + p * FESD_RK_MAX_STAGES);
+  }
+}
+
+void fesd__poly_state(const fesd_integrator *it, const double *z, int n, const double *w, double *x) {
+  const fesd__system *S = &it->sys;
+  const double *xn = n == 0 ? S->x0 : z + S->xo[n - 1], h = z[S->ho[n]];
+  memcpy(x, xn, (size_t)S->nx * sizeof(double));
+  for (int j = 0; j < S->s; j++) {
+    const double hw = h * w[j], *v = z + fesd__v(S, n, j);
+    for (int r = 0; r < S->nx; r++) x[r] += hw * v[r];
+  }
+}
+
+void fesd__state_at(fesd_integrator *it, const double *z, int N, double t, double *x) {
+  const fesd__system *S = &it->sys;
+  const int nx = S->nx, s = S->s;
+  double tn = 0;
+  int n = 0;
+  while (n + 1 < N && t >= tn + z[S->ho[n]]) tn += z[S->ho[n++]];
+  const double h = z[S->ho[n]];
+  double tau = h > 0 ? (t - tn) / h : 0.0;
+  tau = tau < 0 ? 0 : tau > 1 ? 1 : tau;
+  if (fesd__collocation(it)) {
+    double w[FESD_RK_MAX_STAGES];
+    fesd__colloc_weights(it, tau, w);
+    fesd__poly_state(it, z, n, w, x);
+    return;
+  }
+  /* piecewise linear through (0, x_n), (c_j, X_j), (1, x_{n+1}) */
+  const double *xn = n == 0 ? S->x0 : z + S->xo[n - 1], *x1 = z + S->xo[n];
+  double ca = 0, cb = 1;
+  int ja = -1, jb = -1;
+  for (int j = 0; j < s; j++) {
+    double c = S->tab.c[j];
+    if (c <= tau && c >= ca) ca = c, ja = j;
+    if (c > tau && c < cb) cb = c, jb = j;
+  }
+  double *xa = it->vtmp, *xb = it->vtmp + nx;
+  for (int r = 0; r < nx; r++) {
+    double ka = 0, kb = 0;
+    for (int l = 0; l < s; l++) {
+      if (ja >= 0) ka += S->tab.A[ja][l] * z[fesd__v(S, n, l) + r];
+      if (jb >= 0) kb += S->tab.A[jb][l] * z[fesd__v(S, n, l) + r];
+    }
+    xa[r] = ja >= 0 ? xn[r] + h * ka : xn[r];
+    xb[r] = jb >= 0 ? xn[r] + h * kb : x1[r];
+  }
+  const double f = cb > ca ? (tau - ca) / (cb - ca) : 0.0;
+  for (int r = 0; r < nx; r++) x[r] = xa[r] + f * (xb[r] - xa[r]);
+}
+
+/* Record a violation of subsystem k if it is earlier than the one held. */
+static void note(fesd__violation *v, const fesd__violation *c) {
+  if (!v->found || c->t < v->t) *v = *c;
+}
+
+/* Whether subsystem k's active set changes at the boundary starting element n (act per stage). */
+static int set_changes(const fesd_integrator *it, const unsigned char *act, int n, int k) {
+  if (n == 0) return 0;
+  const int nth = it->nth, s = it->s, a = it->model.th_off[k], b = it->model.th_off[k + 1];
+  const unsigned char *p = act + (size_t)(n * s - 1) * nth, *q = act + (size_t)(n * s) * nth;
+  return memcmp(p + a, q + a, (size_t)(b - a)) != 0;
+}
+
+/* Sign violations at the points the equations see (step start, stage points, boundary LP
+ * points), earliest per mode, folded into per subsystem. A violation is attributed to the
+ * active-set change just before it (first) when the violating mode's own activity changed
+ * there and no point was checked in between (the change chose wrong: a crossing that should
+ * slide), or when its predicted time falls on that boundary (a second mode that joins at a
+ * corner). */
+static void scan_signs(fesd_integrator *it, const double *z, const unsigned char *act, int strict,
+                       fesd__violation *ps) {
+  fesd__system *S = &it->sys;
+  const int nth = S->nth, s = S->s;
+  const double tol = it->set.cc_tol, t_eps = 1e-9 * S->T;
+  for (int i = 0; i < nth; i++) {
+    const int k = it->model.sys_of[i];
+    double t0 = 0, v0 = NAN, t_change = -INFINITY; /* last point value of the monitored quantity */
+    int aprev = act[i];
+    v0 = act[i] ? (it->have_prev_theta ? it->theta_prev[i] : 1.0) : it->lam00[i] * S->wth[i];
+    double tn = 0;
+    int done = 0;
+    for (int n = 0; n < S->N && !done; n++) {
+      const double h = z[S->ho[n]];
+      if (set_changes(it, act, n, k)) t_change = tn;
+      for (int j = 0; j <= s; j++) {
+        double t, val;
+        const int a = act[(size_t)(n * s + (j < s ? j : s - 1)) * nth + i];
+        if (a != aprev) v0 = NAN; /* the active set changes here: no interpolation across */
+        aprev = a;
+        if (j < s) {
+          /* Stage states at c_j = 0 (Lobatto, explicit RK) lie O(h^2) off the element start,
+           * and explicit stages are low-order predictions that can overshoot a surface the
+           * trajectory does not reach: for FESD their indicator signs are not switches
+           * (explicit methods are checked at the element ends). */
+          if (!strict && (S->tab.c[j] == 0.0 || (S->tab.is_explicit && !a))) continue;
+          t = tn + S->tab.c[j] * h;
+          val = a ? z[fesd__th(S, n, j) + i] : z[fesd__la(S, n, j) + i] * S->wth[i];
+        } else {
+          if (!S->bp || a) continue; /* boundary LP point: lambda of inactive modes */
+          t = tn + h;
+          val = z[S->lbo[n] + i] * S->wth[i];
+        }
+        if (val < -tol) {
+          fesd__violation c = {0};
+          c.found = 1;
+          c.t = isnan(v0) ? tn : (v0 > 0 ? t0 + (t - t0) * v0 / (v0 - val) : t0);
+          c.mode = i;
+          c.sys = k;
+          c.enter = !a;
+          c.element = n;
+          c.stage = n * s + (j < s ? j : s); /* j == s: the element-end LP point */
+          c.first = isnan(v0) || c.t <= t_change + t_eps;
+          c.filippov = 0;
+          note(&ps[k], &c);
+          done = 1;
+          break;
+        }
+        t0 = t;
+        v0 = val;
+      }
+      tn += h;
+    }
+  }
+}
+
+/* Total field at an evaluated point with the thetas th, into f (nx). */
+static void total_field(fesd_integrator *it, const fesd__point_eval *pe, const double *th, double *f) {
+  memset(f, 0, (size_t)it->nx * sizeof(double));
+  for (int i = 0; i < it->nth; i++)
+    if (th[i] != 0.0) fesd__F_axpy(&it->model, pe, i, th[i], f);
+}
+
+void fesd__normal_components(fesd_integrator *it, const fesd__point_eval *pe, const double *theta,
+                             int i, int j, double *ai, double *aj) {
+  const fesd__model *m = &it->model;
+  const int k = m->sys_of[i];
+  double *f = it->vtmp;
+  total_field(it, pe, theta, f);
+  for (int l = m->th_off[k]; l < m->th_off[k + 1]; l++)
+    if (theta[l] != 0.0) fesd__F_axpy(m, pe, l, -theta[l], f);
+  /* f: the other subsystems' part; add mode i, then replace it by mode j */
+  fesd__F_axpy(m, pe, i, 1.0, f);
+  *ai = fesd__dg_dot(m, pe, i, f) - fesd__dg_dot(m, pe, j, f);
+  fesd__F_axpy(m, pe, i, -1.0, f);
+  fesd__F_axpy(m, pe, j, 1.0, f);
+  *aj = fesd__dg_dot(m, pe, i, f) - fesd__dg_dot(m, pe, j, f);
+}
+
+/* Filippov's conditions of the 2-mode sliding of subsystem k with modes i, j at an evaluated
+ * point: with psi = g_i - g_j (< 0 in region i) sliding needs d psi/dt >= 0 along mode i and
+ * <= 0 along mode j. Returns the mode whose field clearly points into its own region (the one
+ * that continues), -1 for both (repulsive), -2 for none. */
+static int filippov(fesd_integrator *it, const fesd__point_eval *pe, const double *th, int i, int j,
+                    double rel) {
+  double ai, aj;
+  fesd__normal_components(it, pe, th, i, j, &ai, &aj);
+  const double tol = rel * (fabs(ai) + fabs(aj));
+  const int bad_i = ai < -tol, bad_j = aj > tol;
+  if (bad_i && bad_j) return -1;
+  return bad_i ? i : bad_j ? j : -2;
+}
+
+/* The two active modes of subsystem k in act (or -1). */
+static int two_modes(const fesd_integrator *it, const unsigned char *a, int k, int *j) {
+  int i = -1, cnt = 0;
+  *j = -1;
+  for (int l = it->model.th_off[k]; l < it->model.th_off[k + 1]; l++)
+    if (a[l]) {
+      if (cnt++ == 0) i = l;
+      else *j = l;
+    }
+  return cnt == 2 ? i : -1;
+}
+
+/* Filippov's conditions at the stage points of the elements where a subsystem slides on
+ * two modes. */
+static int scan_filippov(fesd_integrator *it, const double *z, const unsigned char *act, fesd__violation *ps) {
+  fesd__system *S = &it->sys;
+  fesd__model *m = &it->model;
+  const int nth = S->nth, s = S->s;
+  fesd__point_eval pe = {0};
+  pe.F = it->pscr.F;
+  pe.g = it->pscr.g;
+  pe.dgdx = it->pscr.dgdx;
+  double tn = 0;
+  for (int n = 0; n < S->N; n++) {
+    const double h = z[S->ho[n]];
+    const unsigned char *a = act + (size_t)(n * s) * nth;
+    int any = 0;
+    for (int k = 0; k < m->nsys && !any; k++) {
+      int j;
+      any = two_modes(it, a, k, &j) >= 0;
+    }
+    if (any) {
+      for (int q = 0; q < s; q++) {
+        if (S->tab.c[q] == 0.0 && n > 0) continue; /* the element start: checked before */
+        double *X = it->gbuf + nth;
+        const double *xn = n == 0 ? S->x0 : z + S->xo[n - 1];
+        for (int r = 0; r < S->nx; r++) {
+          double acc = 0;
+          for (int l = 0; l < s; l++) acc += S->tab.A[q][l] * z[fesd__v(S, n, l) + r];
+          X[r] = xn[r] + h * acc;
+        }
+        int st = fesd__model_eval(m, X, S->u, &pe);
+        if (st) return st;
+        const double *th = z + fesd__th(S, n, q);
+        for (int k = 0; k < m->nsys; k++) {
+          int j, i = two_modes(it, a, k, &j);
+          if (i < 0) continue;
+          /* the element end where k's set changes is the switch point itself (a sliding exit:
+           * the remaining field is tangent there) */
+          if (S->tab.c[q] == 1.0 && n + 1 < S->N && set_changes(it, act, n + 1, k)) continue;
+          int c = filippov(it, &pe, th, i, j, FIL_STAGE_TOL);
+          if (c == -2) continue;
+          fesd__violation v = {1, tn + S->tab.c[q] * h, c < 0 ? i : c, k, 0, n, n * s + q, 0, 1};
+          v.filippov = c < 0 ? -1 : 1;
+          note(&ps[k], &v);
+        }
+      }
+    }
+    tn += h;
+  }
+  return FESD_OK;
+}
+
+/* Between the stage points (collocation methods): the region of the polynomial, and
+ * Filippov's conditions of 2-mode sliding modes (with theta of the nearest stage). */
+static int scan_interior(fesd_integrator *it, const double *z, const unsigned char *act, fesd__violation *ps) {
+  fesd__system *S = &it->sys;
+  fesd__model *m = &it->model;
+  const int s = S->s, nth = S->nth;
+  double *x = it->gbuf + nth;
+  fesd__point_eval pe = {0};
+  pe.F = it->pscr.F;
+  pe.g = it->pscr.g;
+  pe.dgdx = it->pscr.dgdx;
+  double tn = 0;
+  for (int n = 0; n < S->N; n++) {
+    const double h = z[S->ho[n]];
+    const unsigned char *a = act + (size_t)(n * s) * nth;
+    int sliding = 0;
+    for (int k = 0; k < m->nsys && !sliding; k++) {
+      int j;
+      sliding = two_modes(it, a, k, &j) >= 0;
+    }
+    for (int p = 0; p < it->n_mid; p++) {
+      fesd__poly_state(it, z, n, it->mid_w + p * FESD_RK_MAX_STAGES, x);
+      fesd__point_eval q = pe;
+      if (!sliding) q.F = q.dgdx = NULL;
+      int st = fesd__model_eval(m, x, S->u, &q);
+      if (st) return st;
+      const double t = tn + it->mid_tau[p] * h;
+      /* nearest stage for the thetas */
+      int jn = 0;
+      for (int j = 1; j < s; j++)
+        if (fabs(S->tab.c[j] - it->mid_tau[p]) < fabs(S->tab.c[jn] - it->mid_tau[p])) jn = j;
+      const double *th = z + fesd__th(S, n, jn);
+      for (int k = 0; k < m->nsys; k++) {
+        double gact = INFINITY, gin = INFINITY;
+        int lin = -1;
+        for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) {
+          if (a[i]) gact = pe.g[i] < gact ? pe.g[i] : gact;
+          else if (pe.g[i] < gin) gin = pe.g[i], lin = i;
+        }
+        if (lin >= 0 && (gin - gact) * S->wG[k] < -INTERIOR_TOL * it->set.cc_tol) {
+          fesd__violation v = {1, t, lin, k, 1, n, n * s + s, 0, 0};
+          note(&ps[k], &v);
+          continue;
+        }
+        int j, i = two_modes(it, a, k, &j);
+        if (i < 0 || !sliding) continue;
+        int c = filippov(it, &q, th, i, j, FIL_MID_TOL);
+        if (c == -2) continue;
+        fesd__violation v = {1, t, c < 0 ? i : c, k, 0, n, n * s + s, 0, c < 0 ? -1 : 1};
+        note(&ps[k], &v);
+      }
+    }
+    tn += h;
+  }
+  return FESD_OK;
+}
+
+int fesd__scan(fesd_integrator *it, const double *z, const unsigned char *act, int strict,
+               fesd__violation *v, fesd__violation *per_sys) {
+  const int K = it->nsys;
+  fesd__violation *ps = per_sys ? per_sys : it->scan_buf;
+  memset(ps, 0, (size_t)K * sizeof(*ps));
+  scan_signs(it, z, act, strict, ps);
+  int st = FESD_OK;
+  if (!strict && it->set.method == FESD_METHOD_FESD) {
+    st = scan_filippov(it, z, act, ps);
+    if (!st && fesd__collocation(it)) st = scan_interior(it, z, act, ps);
+  }
+  memset(v, 0, sizeof(*v));
+  for (int k = 0; k < K; k++)
+    if (ps[k].found) note(v, &ps[k]);
+  return st;
+}
+
+int fesd__verify(fesd_integrator *it, const double *z, double *ccm) {
+  fesd__system *S = &it->sys;
+  for (int n = 0; n < S->N; n++)
+    if (!(z[S->ho[n]] > 0)) return FESD_ERR_STEP_FAILED;
+  *ccm = fesd__cc_max(S, z);
+  /* boundary LP points (methods with c_s != 1): lambda >= 0 there too, otherwise the
+   * active set changed between the last stage and the element end */
+  if (S->bp)
+    for (int n = 0; n < S->N; n++)
+      for (int i = 0; i < S->nth; i++) {
+        const double l = -z[S->lbo[n] + i] * S->wth[i];
+        *ccm = l > *ccm ? l : *ccm;
+      }
+  if (!(*ccm <= it->set.cc_tol)) return FESD_ERR_STEP_FAILED;
+  /* the active sets the solution claims, stage by stage */
+  for (int p = 0; p < S->N * S->s; p++)
+    fesd__act_from_theta(it, z + fesd__th(S, p / S->s, p % S->s), it->act + (size_t)p * S->nth);
+  fesd__violation v;
+  int st = fesd__scan(it, z, it->act, 0, &v, NULL);
+  if (st) return st;
+  return v.found ? FESD_ERR_STEP_FAILED : FESD_OK;
+}
