@@ -91,26 +91,35 @@ typedef enum {
   FESD_METHOD_STANDARD = 1 /**< standard time-stepping (h_n = T/N_FE fixed) */
 } fesd_method;
 
-/** Integrator settings; fesd_settings_default() fills the documented defaults. */
+/** Integrator settings; fesd_settings_default() fills the documented defaults. fesd_create()
+ *  refuses a value outside its range [lo, hi] with FESD_ERR_INVALID_ARG (NaN is outside every
+ *  range); an unknown family or stage count gives FESD_ERR_UNSUPPORTED_TABLEAU. */
 typedef struct {
-  fesd_method method;       /**< default FESD */
-  fesd_rk_family family;    /**< default Radau IIA */
-  int stages;               /**< s, default 2 */
-  int n_fe;                 /**< finite elements per step, default 2 (FESD needs >= 2) */
-  double newton_tol;        /**< ||F||_inf tolerance of every step solve (default 1e-12) */
-  int max_iter_first;       /**< iterations of the first (equal-h) attempt (default 12) */
-  int max_iter;             /**< iterations of the switch solves (default 40) */
+  fesd_method method;       /**< FESD_METHOD_FESD or FESD_METHOD_STANDARD (default FESD) */
+  fesd_rk_family family;    /**< any family of fesd_rk.h (default Radau IIA) */
+  int stages;               /**< s, as fesd_tableau_get() supports for the family (default 2) */
+  int n_fe;                 /**< finite elements per step: [2, 1000] for FESD, [1, 1000] for
+                                 the standard method (default 2) */
+  double newton_tol;        /**< ||F||_inf tolerance of every step solve, [1e-16, 1e-3]
+                                 (default 1e-12; a loose tolerance lets sum h miss T) */
+  int max_iter_first;       /**< iterations of the first (equal-h) attempt, [1, 1000] (default 12) */
+  int max_iter;             /**< iterations of the switch solves, [1, 1000] (default 40) */
   double cc_tol;            /**< tolerance on every cross-complementarity product
-                                 theta_{n,m,i} lambda_{n,m',i} (units of g; default 1e-9) */
-  double active_tol;        /**< theta_i > active_tol marks mode i active (default 1e-6) */
-  int exit_rows;            /**< pin sliding exits (beyond the paper, docs/sliding_exit.md);
-                                 default 1; 0 = the paper's formulation */
-  int max_splits;           /**< recursive halvings of a failed step (default 6, at most 12) */
-  int sensitivities;        /**< propagate dx/dx0 and dx/du (default 0) */
+                                 theta_{n,m,i} lambda_{n,m',i} (units of g), (0, 1e-2]
+                                 (default 1e-9) */
+  double active_tol;        /**< theta_i > active_tol marks mode i active, (0, 0.1]
+                                 (default 1e-6) */
+  int exit_rows;            /**< 1: pin sliding exits (beyond the paper, docs/sliding_exit.md);
+                                 0: the paper's formulation (default 1) */
+  int max_splits;           /**< recursive halvings of a failed step, [0, 12] (default 6) */
+  int sensitivities;        /**< 1: propagate dx/dx0 and dx/du; 0: not (default 0) */
   int max_sweeps;           /**< fixed-point sweeps that make the initial guess of a step
-                                 consistent (default 8, at least 1; they stop early when
+                                 consistent, [1, 50] (default 8; they stop early when
                                  converged or slow, and cost no Jacobian) */
-  fesd_ncp_settings ncp;    /**< linear algebra/line-search settings of the solver */
+  fesd_ncp_settings ncp;    /**< linear algebra/line-search settings of the solver, ranges as
+                                 in fesd_ncp.h; ncp.tol and ncp.max_iter are ignored (the
+                                 integrator sets them from newton_tol, max_iter_first,
+                                 max_iter) */
 } fesd_settings;
 
 typedef enum {

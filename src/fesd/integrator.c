@@ -27,14 +27,21 @@ int fesd_settings_default(fesd_settings *s) {
   return FESD_OK;
 }
 
+/* Ranges of the settings (documented in include/fesd_integrator.h). Outside them a step
+ * either cannot be solved or returns a state that is not a FESD solution (newton_tol = 1e3
+ * gave sum h != T), so they are refused here; NaN fails every comparison. */
+static int in_range(double v, double lo, double hi) { return v >= lo && v <= hi; }
+static int int_in(int v, int lo, int hi) { return v >= lo && v <= hi; }
+
 static int validate_settings(const fesd_settings *s) {
   if (s->method != FESD_METHOD_FESD && s->method != FESD_METHOD_STANDARD) return FESD_ERR_INVALID_ARG;
-  if (s->n_fe < 1 || s->n_fe > 1000) return FESD_ERR_INVALID_ARG;
-  if (s->method == FESD_METHOD_FESD && s->n_fe < 2) return FESD_ERR_INVALID_ARG;
-  if (!(s->newton_tol > 0) || !(s->cc_tol > 0) || !(s->active_tol > 0)) return FESD_ERR_INVALID_ARG;
-  if (s->max_iter_first < 1 || s->max_iter < 1) return FESD_ERR_INVALID_ARG;
-  if (s->max_splits < 0 || s->max_splits > 12) return FESD_ERR_INVALID_ARG;
-  if (s->max_sweeps < 1 || s->max_sweeps > 50) return FESD_ERR_INVALID_ARG;
+  if (!int_in(s->n_fe, s->method == FESD_METHOD_FESD ? 2 : 1, 1000)) return FESD_ERR_INVALID_ARG;
+  if (!in_range(s->newton_tol, 1e-16, 1e-3)) return FESD_ERR_INVALID_ARG;
+  if (!int_in(s->max_iter_first, 1, 1000) || !int_in(s->max_iter, 1, 1000)) return FESD_ERR_INVALID_ARG;
+  if (!(s->cc_tol > 0 && s->cc_tol <= 1e-2) || !(s->active_tol > 0 && s->active_tol <= 0.1))
+    return FESD_ERR_INVALID_ARG;
+  if (!int_in(s->exit_rows, 0, 1) || !int_in(s->sensitivities, 0, 1)) return FESD_ERR_INVALID_ARG;
+  if (!int_in(s->max_splits, 0, 12) || !int_in(s->max_sweeps, 1, 50)) return FESD_ERR_INVALID_ARG;
   return FESD_OK;
 }
 
@@ -179,8 +186,11 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
     return FESD_ERR_NOMEM;
   }
   fesd_ncp_problem p = {S->n, S->n_eq, S->n_pair, S->nnz, S->prow, S->pcol, fesd__system_eval, S};
+  /* tol and max_iter of the solver are the integrator's (set per solve); the rest is
+   * validated by the solver's setup */
   fesd_ncp_settings ns = settings->ncp;
   ns.tol = settings->newton_tol;
+  ns.max_iter = settings->max_iter;
   if ((st = fesd_ncp_setup(&it->ncp, &p, &ns))) {
     fesd_free(&it);
     return st;
