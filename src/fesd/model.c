@@ -222,7 +222,10 @@ int fesd__model_init(fesd__model *m, const fesd_model *u) {
     m->th_off[k + 1] = m->th_off[k] + nf;
     if (nc > 0) {
       m->S[k] = malloc((size_t)nf * (size_t)nc);
-      if (!m->S[k]) goto fail;
+      if (!m->S[k]) {
+        st = FESD_ERR_NOMEM; /* st holds the last check's FESD_OK from subsystem 1 on */
+        goto fail;
+      }
       if (given)
         memcpy(m->S[k], given, (size_t)nf * (size_t)nc);
       else
