@@ -177,7 +177,10 @@ FESD_API int fesd_set_state(fesd_integrator *it, double t0, const double *x0, co
 /**
  * @brief Advance one integration step of length T with control u (N_FE elements),
  *        warm started from the previous step. On failure the state is unchanged
- *        (the caller may retry with other settings).
+ *        (the caller may retry with other settings). FESD_ERR_NOMEM: an allocation of the
+ *        sparse linear solvers (pattern analyses, factorizations) failed during the step,
+ *        also when another path could have finished it (its result would differ from the
+ *        one of a clean run); a retry repeats the step.
  */
 FESD_API int fesd_step(fesd_integrator *it, const double *u, double T, fesd_step_info *info);
 

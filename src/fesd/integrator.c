@@ -6,6 +6,7 @@
 
 #include "common/timer.h"
 #include "fesd/step.h"
+#include "ncp/ncp_nomem.h"
 
 int fesd_settings_default(fesd_settings *s) {
   if (!s) return FESD_ERR_NULL;
@@ -272,7 +273,11 @@ int fesd_step(fesd_integrator *it, const double *u, double T, fesd_step_info *in
   it->n_events = 0;
   fesd__save(it, &it->bk);
   it->model.failed = NULL;
+  const int nomem0 = fesd__ncp_nomem_count(it->ncp);
   int st = fesd__substep(it, u, T, 0, info);
+  /* an allocation that failed inside the step (the step may have gone on by another path
+   * or by halving) fails the step: its result would differ from the one of a clean run */
+  if (fesd__ncp_nomem_count(it->ncp) != nomem0) st = FESD_ERR_NOMEM;
   info->time = fesd__wall_time() - t0;
   info->status = st;
   if (st != FESD_ERR_CALLBACK && st != FESD_ERR_NONFINITE) info->failed_callback = NULL;

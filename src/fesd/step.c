@@ -392,7 +392,7 @@ int fesd__substep(fesd_integrator *it, const double *u, double T, int depth, fes
   int st = try_step(it, u, T, info);
   if (st == FESD_OK) return st;
   fesd__load(it, &it->bk_sub); /* accept may have failed half-way */
-  if (st == FESD_ERR_CALLBACK) return st;
+  if (st == FESD_ERR_CALLBACK || st == FESD_ERR_NOMEM) return st;
   if (depth >= it->set.max_splits)
     return st == FESD_ERR_TOO_MANY_SWITCHES || st == FESD_ERR_NONFINITE ? st : FESD_ERR_STEP_FAILED;
   info->splits++;

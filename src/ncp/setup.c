@@ -1,5 +1,6 @@
 /* Settings, validation, workspace allocation, row selection, bounds, cleanup. */
 #include "ncp/ncp_internal.h"
+#include "ncp/ncp_nomem.h"
 
 #include <limits.h>
 #include <math.h>
@@ -242,3 +243,5 @@ const char *fesd_ncp_backend_name(int backend) {
   default: return "unknown";
   }
 }
+
+int fesd__ncp_nomem_count(const fesd_ncp *ws) { return ws ? ws->nomem : 0; }
