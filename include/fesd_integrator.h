@@ -27,7 +27,10 @@ extern "C" {
 #endif
 
 /* ---- model callbacks: return 0 on success, nonzero on failure (the step fails with
- *      FESD_ERR_CALLBACK naming the callback and the time). ---- */
+ *      FESD_ERR_CALLBACK naming the callback and the time). A callback must write every
+ *      output entry it is given: an entry left unwritten also gives FESD_ERR_CALLBACK
+ *      (outputs are filled with a marker NaN before each call); a NaN or Inf it writes
+ *      gives FESD_ERR_NONFINITE. ---- */
 
 /** Mode field f_{sys,mode}(x,u): write nx values to f. */
 typedef int (*fesd_field_fn)(int sys, int mode, const double *x, const double *u, double *f,
@@ -150,7 +153,8 @@ typedef struct {
   double residual;      /**< final ||F||_inf of the accepted system */
   double cc_max;        /**< max cross-complementarity product of the accepted solution */
   double time;          /**< wall-clock seconds of the step */
-  const char *failed_callback; /**< on FESD_ERR_CALLBACK/NONFINITE: "field", "switch", ... */
+  const char *failed_callback; /**< on FESD_ERR_CALLBACK/NONFINITE: "field", "switch",
+                                    "field_jac" or "switch_jac" */
   double failed_time;   /**< on failure: start time of the sub-step that failed */
 } fesd_step_info;
 
