@@ -23,6 +23,13 @@ static void usage(void) {
   fprintf(stderr, "\n");
 }
 
+/* "{0,3}": a list of active modes */
+static void print_modes(const int *m, int n) {
+  printf("{");
+  for (int i = 0; i < n; i++) printf(i ? ",%d" : "%d", m[i]);
+  printf("}");
+}
+
 static const char *kind_name(fesd_event_kind k) {
   return k == FESD_EVENT_CROSSING ? "crossing" : k == FESD_EVENT_SLIDING_ENTRY ? "sliding-entry" : "sliding-exit";
 }
@@ -140,9 +147,13 @@ int main(int argc, char **argv) {
     const fesd_event *ev;
     int ne;
     fesd_last_events(it, &ev, &ne);
-    for (int e = 0; e < ne && !quiet; e++)
-      printf("event  t = %.15f  subsystem %d  %-13s modes 0x%x -> 0x%x\n", ev[e].t, ev[e].sys,
-             kind_name(ev[e].kind), ev[e].before, ev[e].after);
+    for (int e = 0; e < ne && !quiet; e++) {
+      printf("event  t = %.15f  subsystem %d  %-13s modes ", ev[e].t, ev[e].sys, kind_name(ev[e].kind));
+      print_modes(ev[e].before, ev[e].n_before);
+      printf(" -> ");
+      print_modes(ev[e].after, ev[e].n_after);
+      printf("\n");
+    }
     if (out) {
       fesd_step_data d;
       fesd_last_step_data(it, &d);

@@ -131,13 +131,16 @@ typedef enum {
   FESD_EVENT_SLIDING_EXIT = 2    /**< active set shrinks (leaving a sliding surface) */
 } fesd_event_kind;
 
-/** A detected switch at an element boundary. */
+/** A detected switch at an element boundary: the set of active modes (theta_i >
+ *  active_tol) of one subsystem changed. kind: after contains before: SLIDING_ENTRY; before
+ *  contains after: SLIDING_EXIT; otherwise CROSSING. */
 typedef struct {
   double t;              /**< time of the element boundary carrying the switch */
   int sys;               /**< subsystem */
   fesd_event_kind kind;
-  unsigned before;       /**< active modes before (bit i = mode i; modes >= 32 not shown) */
-  unsigned after;        /**< active modes after */
+  int n_before, n_after; /**< number of active modes before / after */
+  const int *before;     /**< the active modes before (indices within the subsystem, ascending) */
+  const int *after;      /**< ... and after; both valid until the next fesd_step / fesd_set_state */
 } fesd_event;
 
 /** Statistics of one fesd_step() (accumulated over sub-steps when it splits). */
@@ -196,7 +199,8 @@ FESD_API int fesd_get_state(const fesd_integrator *it, double *t, double *x);
  *         FESD_ERR_NOT_READY if settings.sensitivities was 0. Either pointer may be NULL. */
 FESD_API int fesd_get_sensitivities(const fesd_integrator *it, double *Sx, double *Su);
 
-/** @brief Events detected in the last fesd_step (pointer valid until the next step). */
+/** @brief Events detected in the last fesd_step, at most 256 (the array and the mode lists
+ *         of its events are valid until the next fesd_step / fesd_set_state). */
 FESD_API int fesd_last_events(const fesd_integrator *it, const fesd_event **events, int *count);
 
 /** Per-element data of the last accepted step. */

@@ -73,6 +73,7 @@ void fesd_free(fesd_integrator **itp) {
   free(it->bmode);
   free(it->exit_mode);
   free(it->zfast);
+  free(it->ev_pool);
   free(it);
   *itp = NULL;
 }
@@ -181,7 +182,12 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   it->bmode = calloc(N + 1, sizeof(int));
   it->exit_mode = calloc(N + 1, sizeof(int));
   it->zfast = dalloc(n, &fail);
-  if (fail || !it->eq_active || !it->pair_mode || !it->pt_src || !it->kb || !it->sw_at || !it->act ||
+  int max_nf = 0;
+  for (int k = 0; k < it->nsys; k++) max_nf = it->model.nf[k] > max_nf ? it->model.nf[k] : max_nf;
+  it->ev_span = 2 * max_nf;
+  it->ev_cap = (size_t)FESD_MAX_EVENTS_PER_STEP * (size_t)it->ev_span;
+  it->ev_pool = malloc(it->ev_cap * sizeof(int));
+  if (fail || !it->ev_pool || !it->eq_active || !it->pair_mode || !it->pt_src || !it->kb || !it->sw_at || !it->act ||
       !it->act0 || !it->cand || !it->bmode || !it->exit_mode) {
     fesd_free(&it);
     return FESD_ERR_NOMEM;
