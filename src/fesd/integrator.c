@@ -187,8 +187,8 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   it->ev_span = 2 * max_nf;
   it->ev_cap = (size_t)FESD_MAX_EVENTS_PER_STEP * (size_t)it->ev_span;
   it->ev_pool = malloc(it->ev_cap * sizeof(int));
-  if (fail || !it->ev_pool || !it->eq_active || !it->pair_mode || !it->pt_src || !it->kb || !it->sw_at || !it->act ||
-      !it->act0 || !it->cand || !it->bmode || !it->exit_mode) {
+  if (fail || !it->eq_active || !it->pair_mode || !it->pt_src || !it->kb || !it->sw_at || !it->act ||
+      !it->act0 || !it->cand || !it->bmode || !it->exit_mode || !it->ev_pool) {
     fesd_free(&it);
     return FESD_ERR_NOMEM;
   }

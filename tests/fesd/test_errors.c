@@ -18,7 +18,7 @@
 static int fails = 0;
 #define CHECK FESD_TEST_CHECK
 
-/* ---- test model: the oscillator of the paper (DESIGN.md section 5) with a fault injector ---- */
+/* ---- test model: the oscillator of the paper (src/problems/problems.c) with a fault injector ---- */
 enum { CB_FIELD, CB_SWITCH, CB_FIELD_JAC, CB_SWITCH_JAC, CB_N };
 static const char *const cb_name[CB_N] = {"field", "switch", "field_jac", "switch_jac"};
 enum { FAULT_CODE, FAULT_NAN, FAULT_INF };
@@ -72,7 +72,7 @@ static fesd_model osc_model(injector *in, int with_jac) {
 static const double X0[2] = {0.36787944117144233, 0}; /* e^-1: crosses the circle at t = 1 */
 #define NSTEP 12
 static const double HSTEP = 1.5 / NSTEP;
-/* exact dx(T)/dx0, T > 1, column-major (DESIGN.md section 5, tests/fesd/test_sensitivity.c) */
+/* exact dx(T)/dx0, T > 1, column-major (as tests/fesd/test_sensitivity.c) */
 static void exact_X(double T, double X[4]) {
   double tau = T - 1, e = exp(tau) * exp(1.0), c = cos(W * tau), s = sin(W * tau);
   double RJ[4] = {c - 2 * W * s, -s - 2 * W * c, s, c};

@@ -105,8 +105,8 @@ static void run(int M, int slide) {
                E->n_before == 1 && E->before[0] == a && fabs(E->t - tb[q]) <= 1e-10;
       ok = ok && (entry ? E->n_after == 2 && E->after[0] == lo && E->after[1] == hi
                         : E->n_after == 1 && E->after[0] == b);
-      CHECK(ok, "M = %d: event %d: t = %.15g (exact %.15g), kind %d, modes %d of %d -> %d of %d (expected %d -> %d%s)",
-            M, q, E->t, tb[q], (int)E->kind, E->n_before ? E->before[0] : -1, E->n_before,
+      CHECK(ok,
+            "M = %d: event %d: t = %.15g (exact %.15g), kind %d, modes %d of %d -> %d of %d (expected %d -> %d%s)", M, q, E->t, tb[q], (int)E->kind, E->n_before ? E->before[0] : -1, E->n_before,
             E->n_after ? E->after[0] : -1, E->n_after, a, b, entry ? " + sliding" : "");
       n_cross += ok && !entry;
       n_entry += ok && entry;
@@ -116,8 +116,9 @@ static void run(int M, int slide) {
   }
   double xT;
   fesd_get_state(it, NULL, &xT);
-  CHECK(st == FESD_OK && n_ev == n_expect && fabs(xT - xe) <= 1e-12, "M = %d: %s, %d events (expected %d), x(T) = %.15g (exact %g)",
-        M, fesd_status_name(st), n_ev, n_expect, xT, xe);
+  CHECK(st == FESD_OK && n_ev == n_expect && fabs(xT - xe) <= 1e-12,
+        "M = %d: %s, %d events (expected %d), x(T) = %.15g (exact %g)", M, fesd_status_name(st), n_ev, n_expect, xT,
+        xe);
   printf("M = %3d modes: %2d of %d crossings", M, n_cross, NCROSS);
   if (slide) printf(" and %d of 1 sliding entry", n_entry);
   printf(" reported with the right time, kind and modes (%d of them with a mode >= 32); max event time error "
