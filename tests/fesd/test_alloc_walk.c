@@ -13,7 +13,8 @@
  * with a user sign matrix (dense model API, finite-difference Jacobians), and the friction
  * chain of src/problems with n = 8 (sparse model API, 258 unknowns per step: AUTO picks KLU);
  * backends DENSE, KLU, UMFPACK and AUTO. Skipped (exit 77) under AddressSanitizer, which
- * owns malloc itself. */
+ * owns malloc itself. Needs OPENBLAS_NUM_THREADS=1 (set by meson): threaded OpenBLAS exits
+ * the process when its own buffer allocation fails. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
