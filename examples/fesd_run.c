@@ -1,10 +1,14 @@
-/* fesd-run: integrate a built-in reference problem (DESIGN.md section 5) and print the
+/* fesd-run: integrate a built-in reference problem (src/problems/problems.c) and print the
  * result, the error against the exact solution, the detected events and the solver
  * statistics; optionally write the trajectory (element boundaries) as CSV.
  *
  *   fesd-run --problem oscillator --method fesd --family radau --stages 3 --nfe 2 --nsim 40
  *            [--T 1.5708] [--x0 0.1,0.2] [--csv traj.csv] [--sens] [--no-exit-rows] [--quiet]
+ *
+ * Exit status: 0 success; 1 the integration or an output file failed; 2 bad arguments
+ * (every value is parsed whole, range-checked and must be finite; a message names it).
  */
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -12,6 +16,10 @@
 
 #include "fesd.h"
 #include "problems/problems.h"
+
+#define MAX_NSIM 1000000
+#define MAX_NFE 1000 /* as fesd_settings.n_fe */
+#define MAX_T 1e6
 
 static void usage(void) {
   fprintf(stderr,
@@ -23,8 +31,86 @@ static void usage(void) {
   fprintf(stderr, "\n");
 }
 
+/* The whole of s as an integer in [lo, hi]; otherwise a message and 0. */
+static int parse_int(const char *opt, const char *s, long lo, long hi, int *out) {
+  char *end;
+  errno = 0;
+  long v = strtol(s, &end, 10);
+  if (end == s || *end || errno == ERANGE || v < lo || v > hi) {
+    fprintf(stderr, "fesd-run: %s needs an integer in [%ld, %ld], got '%s'\n", opt, lo, hi, s);
+    return 0;
+  }
+  *out = (int)v;
+  return 1;
+}
+
+/* One finite number at *p (advanced past it); otherwise a message and 0. */
+static int parse_number(const char *opt, const char **p, double *out) {
+  char *end;
+  double v = strtod(*p, &end);
+  if (end == *p) {
+    fprintf(stderr, "fesd-run: %s: '%s' is not a number\n", opt, *p);
+    return 0;
+  }
+  if (!isfinite(v)) {
+    fprintf(stderr, "fesd-run: %s: %.*s is not finite\n", opt, (int)(end - *p), *p);
+    return 0;
+  }
+  *p = end;
+  *out = v;
+  return 1;
+}
+
+/* T: the whole of s, finite, in (0, MAX_T]. */
+static int parse_T(const char *s, double *T) {
+  const char *p = s;
+  if (!parse_number("--T", &p, T)) return 0;
+  if (*p || !(*T > 0 && *T <= MAX_T)) {
+    fprintf(stderr, "fesd-run: --T needs a number in (0, %g], got '%s'\n", MAX_T, s);
+    return 0;
+  }
+  return 1;
+}
+
+/* x0: exactly nx finite numbers separated by commas. */
+static int parse_x0(const char *s, int nx, double *x0) {
+  const char *p = s;
+  for (int i = 0; i < nx; i++) {
+    if (!parse_number("--x0", &p, &x0[i])) return 0;
+    if (i + 1 < nx && *p++ != ',') {
+      fprintf(stderr, "fesd-run: --x0 needs %d comma-separated numbers, got '%s'\n", nx, s);
+      return 0;
+    }
+  }
+  if (*p) {
+    fprintf(stderr, "fesd-run: --x0 needs %d comma-separated numbers, got '%s' (extra '%s')\n", nx, s, p);
+    return 0;
+  }
+  return 1;
+}
+
+/* "{0,3}": a list of active modes */
+static void print_modes(const int *m, int n) {
+  printf("{");
+  for (int i = 0; i < n; i++) printf(i ? ",%d" : "%d", m[i]);
+  printf("}");
+}
+
 static const char *kind_name(fesd_event_kind k) {
   return k == FESD_EVENT_CROSSING ? "crossing" : k == FESD_EVENT_SLIDING_ENTRY ? "sliding-entry" : "sliding-exit";
+}
+
+/* One CSV row per element: t, x, h, the active stacked modes of its last stage ("0;3"). */
+static void csv_rows(FILE *out, const fesd_step_data *d, int nx, double active_tol) {
+  for (int e = 0; e < d->n_elements; e++) {
+    fprintf(out, "%.17g", d->t[e]);
+    for (int i = 0; i < nx; i++) fprintf(out, ",%.17g", d->x[e * nx + i]);
+    fprintf(out, ",%.17g,", d->h[e]);
+    const double *th = d->theta + ((size_t)e * d->stages + d->stages - 1) * d->n_theta;
+    for (int i = 0, first = 1; i < d->n_theta; i++)
+      if (th[i] > active_tol) fprintf(out, first ? "%d" : ";%d", i), first = 0;
+    fprintf(out, "\n");
+  }
 }
 
 int main(int argc, char **argv) {
@@ -47,75 +133,76 @@ int main(int argc, char **argv) {
       quiet = 1;
       continue;
     }
+    if (strncmp(k, "--", 2) || !strcmp(k, "--")) {
+      fprintf(stderr, "fesd-run: unexpected argument '%s'\n", k);
+      usage();
+      return 2;
+    }
     if (!v) {
+      fprintf(stderr, "fesd-run: %s needs a value\n", k);
       usage();
       return 2;
     }
     a++;
+    int ok = 1;
     if (!strcmp(k, "--problem")) prob = v;
     else if (!strcmp(k, "--method")) {
       if (!strcmp(v, "fesd")) set.method = FESD_METHOD_FESD;
       else if (!strcmp(v, "std")) set.method = FESD_METHOD_STANDARD;
       else {
         fprintf(stderr, "fesd-run: unknown method '%s' (fesd or std)\n", v);
-        return 2;
+        ok = 0;
       }
     } else if (!strcmp(k, "--family")) {
       if (fesd_rk_family_parse(v, &set.family) != FESD_OK) {
         fprintf(stderr, "fesd-run: unknown family '%s'\n", v);
-        return 2;
+        ok = 0;
       }
-    } else if (!strcmp(k, "--stages")) set.stages = atoi(v);
-    else if (!strcmp(k, "--nfe")) set.n_fe = atoi(v);
-    else if (!strcmp(k, "--nsim")) nsim = atoi(v);
-    else if (!strcmp(k, "--T")) T = atof(v);
-    else if (!strcmp(k, "--x0")) x0s = v;
+    } else if (!strcmp(k, "--stages")) ok = parse_int(k, v, 1, FESD_RK_MAX_STAGES, &set.stages);
+    else if (!strcmp(k, "--nfe")) ok = parse_int(k, v, 1, MAX_NFE, &set.n_fe);
+    else if (!strcmp(k, "--nsim")) ok = parse_int(k, v, 1, MAX_NSIM, &nsim);
+    else if (!strcmp(k, "--T")) ok = parse_T(v, &T);
+    else if (!strcmp(k, "--x0")) x0s = v; /* parsed once the problem (and nx) is known */
     else if (!strcmp(k, "--csv")) csv = v;
     else {
+      fprintf(stderr, "fesd-run: unknown option '%s'\n", k);
       usage();
       return 2;
     }
+    if (!ok) return 2;
   }
   fesd_problem P;
   if (!prob || fesd_problem_get(prob, &P) != FESD_OK) {
     if (prob) fprintf(stderr, "fesd-run: unknown problem '%s'\n", prob);
+    else fprintf(stderr, "fesd-run: --problem is required\n");
     usage();
     return 2;
   }
-  if (nsim < 1) {
-    fprintf(stderr, "fesd-run: --nsim must be >= 1\n");
+  if (set.method == FESD_METHOD_FESD && set.n_fe < 2) {
+    fprintf(stderr, "fesd-run: --nfe must be >= 2 with --method fesd (a switch needs an element boundary)\n");
     return 2;
   }
-  int nx = P.model.nx;
+  const int nx = P.model.nx;
   if (x0s) {
-    char *end;
-    const char *p = x0s;
-    for (int i = 0; i < nx; i++) {
-      P.x0[i] = strtod(p, &end);
-      if (end == p) {
-        fprintf(stderr, "fesd-run: --x0 needs %d comma-separated numbers\n", nx);
-        return 2;
-      }
-      p = *end == ',' ? end + 1 : end;
-    }
+    if (!parse_x0(x0s, nx, P.x0)) return 2;
     P.exact = NULL; /* exact solutions are for the default x0 only */
   }
-  if (isfinite(T)) {
-    if (!(T > 0)) {
-      fprintf(stderr, "fesd-run: --T must be > 0\n");
-      return 2;
-    }
-    P.T = T;
-  }
+  if (!isnan(T)) P.T = T;
   fesd_integrator *it;
   int st = fesd_create(&it, &P.model, &set);
   if (st) {
     fprintf(stderr, "fesd-run: setup failed: %s (%s)\n", fesd_status_string(st), fesd_status_name(st));
+    /* a family/stage combination or a setting the library refuses is an argument error */
+    return st == FESD_ERR_INVALID_ARG || st == FESD_ERR_UNSUPPORTED_TABLEAU ? 2 : 1;
+  }
+  if ((st = fesd_set_state(it, 0.0, P.x0, P.u))) {
+    fprintf(stderr, "fesd-run: initial state refused: %s (%s)\n", fesd_status_string(st), fesd_status_name(st));
+    fesd_free(&it);
     return 1;
   }
   FILE *out = NULL;
   if (csv && !(out = fopen(csv, "w"))) {
-    fprintf(stderr, "fesd-run: cannot write %s\n", csv);
+    fprintf(stderr, "fesd-run: cannot write %s: %s\n", csv, strerror(errno));
     fesd_free(&it);
     return 1;
   }
@@ -124,9 +211,6 @@ int main(int argc, char **argv) {
     for (int i = 0; i < nx; i++) fprintf(out, ",x%d", i + 1);
     fprintf(out, ",h,active\n");
   }
-  fesd_set_state(it, 0.0, P.x0, P.u);
-  int nth;
-  fesd_dims(it, &nth, NULL);
   double x[FESD_PROBLEM_MAX_NX];
   for (int k = 0; k < nsim; k++) {
     fesd_step_info info;
@@ -140,29 +224,31 @@ int main(int argc, char **argv) {
     const fesd_event *ev;
     int ne;
     fesd_last_events(it, &ev, &ne);
-    for (int e = 0; e < ne && !quiet; e++)
-      printf("event  t = %.15f  subsystem %d  %-13s modes 0x%x -> 0x%x\n", ev[e].t, ev[e].sys,
-             kind_name(ev[e].kind), ev[e].before, ev[e].after);
+    for (int e = 0; e < ne && !quiet; e++) {
+      printf("event  t = %.15f  subsystem %d  %-13s modes ", ev[e].t, ev[e].sys, kind_name(ev[e].kind));
+      print_modes(ev[e].before, ev[e].n_before);
+      printf(" -> ");
+      print_modes(ev[e].after, ev[e].n_after);
+      printf("\n");
+    }
     if (out) {
       fesd_step_data d;
       fesd_last_step_data(it, &d);
-      for (int e = 0; e < d.n_elements; e++) {
-        fprintf(out, "%.17g", d.t[e]);
-        for (int i = 0; i < nx; i++) fprintf(out, ",%.17g", d.x[e * nx + i]);
-        unsigned act = 0;
-        for (int i = 0; i < nth && i < 32; i++)
-          if (d.theta[((size_t)e * d.stages + d.stages - 1) * nth + i] > set.active_tol) act |= 1u << i;
-        fprintf(out, ",%.17g,%u\n", d.h[e], act);
-      }
+      csv_rows(out, &d, nx, set.active_tol);
     }
   }
   double t;
   fesd_get_state(it, &t, x);
+  int io = 0; /* an output that could not be written fails the run */
   if (out) {
     fprintf(out, "%.17g", t);
     for (int i = 0; i < nx; i++) fprintf(out, ",%.17g", x[i]);
     fprintf(out, ",,\n");
-    fclose(out);
+    int werr = ferror(out), cerr = fclose(out);
+    if (werr || cerr) {
+      fprintf(stderr, "fesd-run: writing %s failed: %s\n", csv, strerror(errno));
+      io = 1;
+    }
   }
   fesd_stats S;
   fesd_get_stats(it, &S);
@@ -195,5 +281,9 @@ int main(int argc, char **argv) {
          S.max_iter_ordinary_step, S.mean_iter_switch_step, S.max_iter_switch_step, S.factorizations,
          S.events, 1e3 * S.time);
   fesd_free(&it);
-  return st == FESD_OK ? 0 : 1;
+  if (fflush(stdout) || ferror(stdout)) {
+    fprintf(stderr, "fesd-run: writing the standard output failed: %s\n", strerror(errno));
+    io = 1;
+  }
+  return st == FESD_OK && !io ? 0 : 1;
 }

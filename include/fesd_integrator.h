@@ -27,7 +27,10 @@ extern "C" {
 #endif
 
 /* ---- model callbacks: return 0 on success, nonzero on failure (the step fails with
- *      FESD_ERR_CALLBACK naming the callback and the time). ---- */
+ *      FESD_ERR_CALLBACK naming the callback and the time). A callback must write every
+ *      output entry it is given: an entry left unwritten also gives FESD_ERR_CALLBACK
+ *      (outputs are filled with a marker NaN before each call); a NaN or Inf it writes
+ *      gives FESD_ERR_NONFINITE. ---- */
 
 /** Mode field f_{sys,mode}(x,u): write nx values to f. */
 typedef int (*fesd_field_fn)(int sys, int mode, const double *x, const double *u, double *f,
@@ -91,32 +94,41 @@ typedef enum {
   FESD_METHOD_STANDARD = 1 /**< standard time-stepping (h_n = T/N_FE fixed) */
 } fesd_method;
 
-/** Integrator settings; fesd_settings_default() fills the documented defaults. */
+/** Integrator settings; fesd_settings_default() fills the documented defaults. fesd_create()
+ *  refuses a value outside its range [lo, hi] with FESD_ERR_INVALID_ARG (NaN is outside every
+ *  range); an unknown family or stage count gives FESD_ERR_UNSUPPORTED_TABLEAU. */
 typedef struct {
-  fesd_method method;       /**< default FESD */
-  fesd_rk_family family;    /**< default Radau IIA */
-  int stages;               /**< s, default 2 */
-  int n_fe;                 /**< finite elements per step, default 2 (FESD needs >= 2) */
-  double newton_tol;        /**< ||F||_inf tolerance of every step solve (default 1e-12) */
-  int max_iter_first;       /**< iterations of the first (equal-h) attempt (default 12) */
-  int max_iter;             /**< iterations of the switch solves (default 40) */
+  fesd_method method;       /**< FESD_METHOD_FESD or FESD_METHOD_STANDARD (default FESD) */
+  fesd_rk_family family;    /**< any family of fesd_rk.h (default Radau IIA) */
+  int stages;               /**< s, as fesd_tableau_get() supports for the family (default 2) */
+  int n_fe;                 /**< finite elements per step: [2, 1000] for FESD, [1, 1000] for
+                                 the standard method (default 2) */
+  double newton_tol;        /**< ||F||_inf tolerance of every step solve, [1e-16, 1e-3]
+                                 (default 1e-12; a loose tolerance lets sum h miss T) */
+  int max_iter_first;       /**< iterations of the first (equal-h) attempt, [1, 1000] (default 12) */
+  int max_iter;             /**< iterations of the switch solves, [1, 1000] (default 40) */
   double cc_tol;            /**< tolerance on every cross-complementarity product
-                                 theta_{n,m,i} lambda_{n,m',i} (units of g; default 1e-9) */
-  double active_tol;        /**< theta_i > active_tol marks mode i active (default 1e-6) */
-  int exit_rows;            /**< pin sliding exits (beyond the paper, docs/sliding_exit.md);
-                                 default 1; 0 = the paper's formulation */
-  int max_splits;           /**< recursive halvings of a failed step (default 6, at most 12) */
-  int sensitivities;        /**< propagate dx/dx0 and dx/du (default 0) */
+                                 theta_{n,m,i} lambda_{n,m',i} (units of g), (0, 1e-2]
+                                 (default 1e-9) */
+  double active_tol;        /**< theta_i > active_tol marks mode i active, (0, 0.1]
+                                 (default 1e-6) */
+  int exit_rows;            /**< 1: pin sliding exits (beyond the paper, docs/sliding_exit.md);
+                                 0: the paper's formulation (default 1) */
+  int max_splits;           /**< recursive halvings of a failed step, [0, 12] (default 6) */
+  int sensitivities;        /**< 1: propagate dx/dx0 and dx/du; 0: not (default 0) */
   int max_sweeps;           /**< fixed-point sweeps that make the initial guess of a step
-                                 consistent (default 8, at least 1; they stop early when
+                                 consistent, [1, 50] (default 8; they stop early when
                                  converged or slow, and cost no Jacobian) */
   int max_elements;         /**< most elements of one solve (FESD): a step that holds k
                                  switches gets max(n_fe, k + 1) elements (one boundary per
                                  switch); one that holds more than max_elements - 1 is solved
-                                 in sub-steps that end between two switches. Default 32, range
-                                 [n_fe, 4096]; memory grows with it (step data of that many
-                                 elements) */
-  fesd_ncp_settings ncp;    /**< linear algebra/line-search settings of the solver */
+                                 in sub-steps that end between two switches. [2, 4096] (default
+                                 32; at least n_fe is used); memory grows with it (step data of
+                                 that many elements) */
+  fesd_ncp_settings ncp;    /**< linear algebra/line-search settings of the solver, ranges as
+                                 in fesd_ncp.h; ncp.tol and ncp.max_iter are ignored (the
+                                 integrator sets them from newton_tol, max_iter_first,
+                                 max_iter) */
 } fesd_settings;
 
 typedef enum {
@@ -125,13 +137,16 @@ typedef enum {
   FESD_EVENT_SLIDING_EXIT = 2    /**< active set shrinks (leaving a sliding surface) */
 } fesd_event_kind;
 
-/** A detected switch at an element boundary. */
+/** A detected switch at an element boundary: the set of active modes (theta_i >
+ *  active_tol) of one subsystem changed. kind: after contains before: SLIDING_ENTRY; before
+ *  contains after: SLIDING_EXIT; otherwise CROSSING. */
 typedef struct {
   double t;              /**< time of the element boundary carrying the switch */
   int sys;               /**< subsystem */
   fesd_event_kind kind;
-  unsigned before;       /**< active modes before (bit i = mode i; modes >= 32 not shown) */
-  unsigned after;        /**< active modes after */
+  int n_before, n_after; /**< number of active modes before / after */
+  const int *before;     /**< the active modes before (indices within the subsystem, ascending) */
+  const int *after;      /**< ... and after; both valid until the next fesd_step / fesd_set_state */
 } fesd_event;
 
 /** Flags of a step (fesd_step_info.flags, counted in fesd_stats.flagged): the result was
@@ -156,7 +171,8 @@ typedef struct {
   double residual;      /**< final ||F||_inf of the accepted system */
   double cc_max;        /**< max cross-complementarity product of the accepted solution */
   double time;          /**< wall-clock seconds of the step */
-  const char *failed_callback; /**< on FESD_ERR_CALLBACK/NONFINITE: "field", "switch", ... */
+  const char *failed_callback; /**< on FESD_ERR_CALLBACK/NONFINITE: "field", "switch",
+                                    "field_jac" or "switch_jac" */
   double failed_time;   /**< on failure: start time of the sub-step that failed */
 } fesd_step_info;
 
@@ -183,7 +199,10 @@ FESD_API int fesd_set_state(fesd_integrator *it, double t0, const double *x0, co
 /**
  * @brief Advance one integration step of length T with control u (N_FE elements),
  *        warm started from the previous step. On failure the state is unchanged
- *        (the caller may retry with other settings).
+ *        (the caller may retry with other settings). FESD_ERR_NOMEM: an allocation of the
+ *        sparse linear solvers (pattern analyses, factorizations) failed during the step,
+ *        also when another path could have finished it (its result would differ from the
+ *        one of a clean run); a retry repeats the step.
  */
 FESD_API int fesd_step(fesd_integrator *it, const double *u, double T, fesd_step_info *info);
 
@@ -195,7 +214,8 @@ FESD_API int fesd_get_state(const fesd_integrator *it, double *t, double *x);
  *         FESD_ERR_NOT_READY if settings.sensitivities was 0. Either pointer may be NULL. */
 FESD_API int fesd_get_sensitivities(const fesd_integrator *it, double *Sx, double *Su);
 
-/** @brief Events detected in the last fesd_step (pointer valid until the next step). */
+/** @brief Events detected in the last fesd_step, at most 256 (the array and the mode lists
+ *         of its events are valid until the next fesd_step / fesd_set_state). */
 FESD_API int fesd_last_events(const fesd_integrator *it, const fesd_event **events, int *count);
 
 /** Per-element data of the last accepted step. */

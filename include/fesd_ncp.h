@@ -93,19 +93,22 @@ typedef struct {
 /** Log sink for iteration logs; msg is one line without newline. */
 typedef void (*fesd_ncp_log_fn)(void *log_user, const char *msg);
 
+/** Solver settings; fesd_ncp_settings_default() fills the defaults. fesd_ncp_setup() and
+ *  fesd_ncp_update_settings() refuse a value outside its range with FESD_ERR_INVALID_ARG
+ *  (NaN is outside every range). */
 typedef struct {
-  double tol;            /**< ||F||_inf convergence tolerance (default 1e-12) */
-  int max_iter;          /**< Newton/LM iterations per sigma stage (default 50) */
-  fesd_ncp_backend backend; /**< default AUTO */
-  int dense_max_n;       /**< AUTO uses the dense backend up to this n (default FESD_NCP_DENSE_MAX_N) */
-  double armijo;         /**< Armijo constant c1 in (0, 0.5) (default 1e-4) */
-  double backtrack;      /**< step reduction factor in (0,1) (default 0.5) */
-  int max_backtracks;    /**< line-search trials per direction (default 30; a Newton direction gets at most 10 before the fallback) */
-  double sigma0;         /**< first smoothing parameter of the homotopy (default 1e-1) */
-  double sigma_factor;   /**< sigma_{k+1} = factor * sigma_k (default 0.1) */
-  double sigma_min;      /**< last positive sigma before the final sigma = 0 stage (default 1e-8) */
-  double homotopy_tol_factor; /**< intermediate stages stop at ||F|| <= factor*sigma (default 1e-2) */
-  double lm_mu0;         /**< initial LM damping factor: mu = lambda ||F||_2, lambda adapted by the gain ratio (default 1e-3) */
+  double tol;            /**< ||F||_inf convergence tolerance, [1e-16, 1e-1] (default 1e-12) */
+  int max_iter;          /**< Newton/LM iterations per sigma stage, [1, 1000] (default 50) */
+  fesd_ncp_backend backend; /**< a fesd_ncp_backend value (default AUTO) */
+  int dense_max_n;       /**< AUTO uses the dense backend up to this n, [0, 5000] (default FESD_NCP_DENSE_MAX_N) */
+  double armijo;         /**< Armijo constant c1, (0, 0.5) (default 1e-4) */
+  double backtrack;      /**< step reduction factor, (0, 1) (default 0.5) */
+  int max_backtracks;    /**< line-search trials per direction, [1, 100] (default 30; a Newton direction gets at most 10 before the fallback) */
+  double sigma0;         /**< first smoothing parameter of the homotopy, (0, 1e3] (default 1e-1) */
+  double sigma_factor;   /**< sigma_{k+1} = factor * sigma_k, (0, 0.9] (default 0.1) */
+  double sigma_min;      /**< last positive sigma before the final sigma = 0 stage, [1e-16, sigma0] (default 1e-8) */
+  double homotopy_tol_factor; /**< intermediate stages stop at ||F|| <= factor*sigma, (0, 1] (default 1e-2) */
+  double lm_mu0;         /**< initial LM damping factor: mu = lambda ||F||_2, lambda adapted by the gain ratio, [1e-10, 1e10] (default 1e-3) */
   fesd_ncp_log_fn log;   /**< optional iteration log (default NULL = silent) */
   void *log_user;
 } fesd_ncp_settings;

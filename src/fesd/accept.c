@@ -123,31 +123,63 @@ static int chain_sensitivities(fesd_integrator *it, const double *z) {
   return FESD_OK;
 }
 
-static unsigned active_bits(const fesd_integrator *it, const double *th, int k) {
-  unsigned bits = 0;
+/* Active modes of subsystem k (theta above active_tol; indices within the subsystem,
+ * ascending) into out; returns their number. One stage of theta: */
+static int active_modes(const fesd_integrator *it, const double *th, int k, int *out) {
   const fesd__model *m = &it->model;
-  for (int i = m->th_off[k]; i < m->th_off[k + 1] && i - m->th_off[k] < 32; i++)
-    if (th[i] > it->set.active_tol) bits |= 1u << (i - m->th_off[k]);
-  return bits;
+  int c = 0;
+  for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++)
+    if (th[i] > it->set.active_tol) out[c++] = i - m->th_off[k];
+  return c;
 }
 
-/* Active modes of element n of z (theta above active_tol at any stage). */
-static unsigned element_bits(const fesd_integrator *it, const double *z, int n, int k) {
-  unsigned bits = 0;
-  for (int j = 0; j < it->s; j++) bits |= active_bits(it, z + fesd__th(&it->sys, n, j), k);
-  return bits;
+/* ... and element n of z (active at any stage). */
+static int element_modes(const fesd_integrator *it, const double *z, int n, int k, int *out) {
+  const fesd__model *m = &it->model;
+  int c = 0;
+  for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++)
+    for (int j = 0; j < it->s; j++)
+      if (z[fesd__th(&it->sys, n, j) + i] > it->set.active_tol) {
+        out[c++] = i - m->th_off[k];
+        break;
+      }
+  return c;
 }
 
-static void add_event(fesd_integrator *it, double t, int k, unsigned before, unsigned after) {
-  if (before == after || it->n_events >= FESD_MAX_EVENTS_PER_STEP) return;
+/* Free room of the event pool for one more event (before and after lists of up to
+ * ev_span ints), or NULL when the step has no room left. The used part ends after the last
+ * event's lists, so a sub-step restored by fesd__load frees its events' lists too. */
+static int *event_room(fesd_integrator *it) {
+  if (it->n_events >= FESD_MAX_EVENTS_PER_STEP) return NULL;
+  const fesd_event *last = it->n_events ? &it->events[it->n_events - 1] : NULL;
+  const size_t used = last ? (size_t)(last->after + last->n_after - it->ev_pool) : 0;
+  return used + (size_t)it->ev_span <= it->ev_cap ? it->ev_pool + used : NULL;
+}
+
+/* a (na entries) is a subset of b (nb); both ascending */
+static int subset(const int *a, int na, const int *b, int nb) {
+  for (int i = 0, j = 0; i < na; i++, j++) {
+    while (j < nb && b[j] < a[i]) j++;
+    if (j == nb || b[j] != a[i]) return 0;
+  }
+  return 1;
+}
+
+/* Record a switch of subsystem k at t if the active sets differ; before (nb) and after (na)
+ * lie in the room given by event_room, after = before + nb. */
+static void add_event(fesd_integrator *it, double t, int k, const int *before, int nb, int na) {
+  const int *after = before + nb;
+  if (nb == na && !memcmp(before, after, (size_t)nb * sizeof(int))) return;
   fesd_event *e = &it->events[it->n_events++];
   e->t = t;
   e->sys = k;
+  e->n_before = nb;
+  e->n_after = na;
   e->before = before;
   e->after = after;
-  if ((after & before) == before)
+  if (subset(before, nb, after, na))
     e->kind = FESD_EVENT_SLIDING_ENTRY;
-  else if ((after & before) == after)
+  else if (subset(after, na, before, nb))
     e->kind = FESD_EVENT_SLIDING_EXIT;
   else
     e->kind = FESD_EVENT_CROSSING;
@@ -193,19 +225,22 @@ int fesd__accept(fesd_integrator *it, const double *z, const double *u, double T
     }
     /* events at the left boundary of element n */
     for (int k = 0; k < nsys; k++) {
-      unsigned before = n == 0 ? (it->have_prev_theta ? active_bits(it, it->theta_prev, k) : 0)
-                               : element_bits(it, z, n - 1, k);
-      if (n == 0 && !it->have_prev_theta) continue;
-      add_event(it, t, k, before, element_bits(it, z, n, k));
+      int *b = event_room(it);
+      if (!b || (n == 0 && !it->have_prev_theta)) continue;
+      int nb = n == 0 ? active_modes(it, it->theta_prev, k, b) : element_modes(it, z, n - 1, k, b);
+      add_event(it, t, k, b, nb, element_modes(it, z, n, k, b + nb));
     }
     t += z[S->ho[n]];
   }
   /* a mode that drops out exactly at the step end (a sliding exit on the step grid): its
    * theta vanishes only at the last stage, so the next step starts without it and neither
    * boundary comparison sees the change */
-  for (int k = 0; k < nsys; k++)
-    add_event(it, it->t + T, k, element_bits(it, z, N - 1, k),
-              active_bits(it, z + fesd__th(S, N - 1, s - 1), k));
+  for (int k = 0; k < nsys; k++) {
+    int *b = event_room(it);
+    if (!b) continue;
+    int nb = element_modes(it, z, N - 1, k, b);
+    add_event(it, it->t + T, k, b, nb, active_modes(it, z + fesd__th(S, N - 1, s - 1), k, b + nb));
+  }
   it->rec_t[it->n_el] = it->t + T;
   memcpy(it->rec_x + (size_t)it->n_el * nx, z + S->xo[N - 1], (size_t)nx * sizeof(double));
   /* state */

@@ -6,6 +6,7 @@
 
 #include "common/timer.h"
 #include "fesd/step.h"
+#include "ncp/ncp_nomem.h"
 
 int fesd_settings_default(fesd_settings *s) {
   if (!s) return FESD_ERR_NULL;
@@ -28,15 +29,22 @@ int fesd_settings_default(fesd_settings *s) {
   return FESD_OK;
 }
 
+/* Ranges of the settings (documented in include/fesd_integrator.h). Outside them a step
+ * either cannot be solved or returns a state that is not a FESD solution (newton_tol = 1e3
+ * gave sum h != T), so they are refused here; NaN fails every comparison. */
+static int in_range(double v, double lo, double hi) { return v >= lo && v <= hi; }
+static int int_in(int v, int lo, int hi) { return v >= lo && v <= hi; }
+
 static int validate_settings(const fesd_settings *s) {
   if (s->method != FESD_METHOD_FESD && s->method != FESD_METHOD_STANDARD) return FESD_ERR_INVALID_ARG;
-  if (s->n_fe < 1 || s->n_fe > 1000) return FESD_ERR_INVALID_ARG;
-  if (s->method == FESD_METHOD_FESD && s->n_fe < 2) return FESD_ERR_INVALID_ARG;
-  if (!(s->newton_tol > 0) || !(s->cc_tol > 0) || !(s->active_tol > 0)) return FESD_ERR_INVALID_ARG;
-  if (s->max_iter_first < 1 || s->max_iter < 1) return FESD_ERR_INVALID_ARG;
-  if (s->max_splits < 0 || s->max_splits > 12) return FESD_ERR_INVALID_ARG;
-  if (s->max_sweeps < 1 || s->max_sweeps > 50) return FESD_ERR_INVALID_ARG;
-  if (s->max_elements < s->n_fe || s->max_elements > 4096) return FESD_ERR_INVALID_ARG;
+  if (!int_in(s->n_fe, s->method == FESD_METHOD_FESD ? 2 : 1, 1000)) return FESD_ERR_INVALID_ARG;
+  if (!in_range(s->newton_tol, 1e-16, 1e-3)) return FESD_ERR_INVALID_ARG;
+  if (!int_in(s->max_iter_first, 1, 1000) || !int_in(s->max_iter, 1, 1000)) return FESD_ERR_INVALID_ARG;
+  if (!(s->cc_tol > 0 && s->cc_tol <= 1e-2) || !(s->active_tol > 0 && s->active_tol <= 0.1))
+    return FESD_ERR_INVALID_ARG;
+  if (!int_in(s->exit_rows, 0, 1) || !int_in(s->sensitivities, 0, 1)) return FESD_ERR_INVALID_ARG;
+  if (!int_in(s->max_splits, 0, 12) || !int_in(s->max_sweeps, 1, 50)) return FESD_ERR_INVALID_ARG;
+  if (!int_in(s->max_elements, 2, 4096)) return FESD_ERR_INVALID_ARG;
   return FESD_OK;
 }
 
@@ -67,7 +75,7 @@ void fesd_free(fesd_integrator **itp) {
   }
   void *other[] = {it->eq_active, it->pair_mode, it->pt_src, it->kb,   it->sw_at,    it->act,
                    it->act0,      it->cand,      it->swap_set, it->bmode, it->exit_mode, it->jump_in,
-                   it->jump_out,  it->scan_buf,  it->plan,   it->plan_after, it->bseg};
+                   it->jump_out,  it->scan_buf,  it->plan,   it->plan_after, it->bseg, it->ev_pool};
   for (size_t i = 0; i < sizeof(other) / sizeof(other[0]); i++) free(other[i]);
   free(it);
   *itp = NULL;
@@ -97,7 +105,8 @@ int fesd__use_level(fesd_integrator *it, int N) {
       fesd__system_pattern(S, row, col);
       fesd_ncp_problem p = {S->n, S->n_eq, S->n_pair, S->nnz, row, col, fesd__system_eval, S};
       fesd_ncp_settings ns = it->set.ncp;
-      ns.tol = it->set.newton_tol;
+      ns.tol = it->set.newton_tol; /* tol and max_iter are set per solve (step.c) */
+      ns.max_iter = it->set.max_iter;
       st = fesd_ncp_setup(&L->ncp, &p, &ns);
     }
     free(row);
@@ -148,7 +157,7 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
     free(it);
     return st;
   }
-  it->N_cap = settings->max_elements;
+  it->N_cap = settings->max_elements > settings->n_fe ? settings->max_elements : settings->n_fe;
   if ((st = fesd__system_init(&it->sys, &it->model, &tab, it->N_cap, settings->sensitivities))) {
     fesd__model_free(&it->model);
     free(it);
@@ -223,9 +232,14 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   it->plan = malloc(cp * sizeof(*it->plan));
   it->plan_after = malloc(cp * nth);
   it->bseg = malloc((cp + 2) * sizeof(int));
+  int max_nf = 0;
+  for (int k = 0; k < it->nsys; k++) max_nf = it->model.nf[k] > max_nf ? it->model.nf[k] : max_nf;
+  it->ev_span = 2 * max_nf;
+  it->ev_cap = (size_t)FESD_MAX_EVENTS_PER_STEP * (size_t)it->ev_span;
+  it->ev_pool = malloc(it->ev_cap * sizeof(int));
   if (fail || !it->eq_active || !it->pair_mode || !it->pt_src || !it->kb || !it->sw_at || !it->act ||
       !it->act0 || !it->cand || !it->swap_set || !it->bmode || !it->exit_mode || !it->jump_in ||
-      !it->jump_out || !it->scan_buf || !it->plan || !it->plan_after || !it->bseg) {
+      !it->jump_out || !it->scan_buf || !it->plan || !it->plan_after || !it->bseg || !it->ev_pool) {
     fesd_free(&it);
     return FESD_ERR_NOMEM;
   }
@@ -296,6 +310,13 @@ void fesd__load(fesd_integrator *it, const fesd__saved *b) {
   memcpy(it->sys.lam00_dp, b->ldp, nth * (size_t)it->np * sizeof(double));
 }
 
+/* Allocation failures met by the solver workspaces of every layout. */
+static long nomem_count(const fesd_integrator *it) {
+  long c = 0;
+  for (int l = 0; l < it->n_lv; l++) c += fesd__ncp_nomem_count(it->lv[l].ncp);
+  return c;
+}
+
 int fesd_step(fesd_integrator *it, const double *u, double T, fesd_step_info *info) {
   fesd_step_info local;
   if (!info) info = &local;
@@ -312,7 +333,11 @@ int fesd_step(fesd_integrator *it, const double *u, double T, fesd_step_info *in
   fesd__save(it, &it->bk);
   it->model.failed = NULL;
   const double t_start = it->t;
+  const long nomem0 = nomem_count(it);
   int st = fesd__substep(it, u, T, 0, info);
+  /* an allocation that failed inside the step (the step may have gone on by another path
+   * or by halving) fails the step: its result would differ from the one of a clean run */
+  if (nomem_count(it) != nomem0) st = FESD_ERR_NOMEM;
   if (st == FESD_OK) it->t = t_start + T; /* sub-steps add up to T up to round-off */
   info->time = fesd__wall_time() - t0;
   info->status = st;

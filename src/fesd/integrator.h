@@ -2,6 +2,8 @@
 #ifndef FESD_INTEGRATOR_INTERNAL_H
 #define FESD_INTEGRATOR_INTERNAL_H
 
+#include <stddef.h>
+
 #include "fesd/model.h"
 #include "fesd/system.h"
 #include "fesd_integrator.h"
@@ -101,6 +103,10 @@ struct fesd_integrator {
   double mid_tau[FESD_RK_MAX_STAGES + 1];
   fesd_event events[FESD_MAX_EVENTS_PER_STEP];
   int n_events;
+  /* active-mode lists of the events (accept.c): ev_span = 2 x the largest n_modes ints per
+   * event, ev_cap = FESD_MAX_EVENTS_PER_STEP ev_span, allocated at create */
+  int *ev_pool, ev_span;
+  size_t ev_cap;
   fesd_stats stats;
   double sum_iter_ord, sum_iter_sw;
 };

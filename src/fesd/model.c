@@ -1,13 +1,36 @@
 #include "fesd/model.h"
 
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
-static int all_finite(const double *v, int n) {
-  for (int i = 0; i < n; i++)
-    if (!isfinite(v[i])) return 0;
-  return 1;
+/* Callback outputs are filled with this quiet NaN before the call. Arithmetic never creates
+ * its payload (a NaN result carries the default payload or that of a NaN operand), so an
+ * entry still bit-identical to it afterwards was not written (or was computed from an
+ * unwritten output): the callback broke its contract, and the stale value it left must not
+ * be used. */
+#define UNWRITTEN_BITS 0x7ff8fe5d0badf00dULL
+
+static void mark_unwritten(double *v, int n) {
+  const uint64_t bits = UNWRITTEN_BITS;
+  double s;
+  memcpy(&s, &bits, sizeof s);
+  for (int i = 0; i < n; i++) v[i] = s;
+}
+
+/* FESD_OK if the n outputs are finite; FESD_ERR_CALLBACK if one was not written (that
+ * takes precedence), FESD_ERR_NONFINITE for another NaN or Inf. */
+static int check_outputs(const double *v, int n) {
+  int st = FESD_OK;
+  for (int i = 0; i < n; i++) {
+    if (isfinite(v[i])) continue;
+    uint64_t bits;
+    memcpy(&bits, &v[i], sizeof bits);
+    if (bits == UNWRITTEN_BITS) return FESD_ERR_CALLBACK;
+    st = FESD_ERR_NONFINITE;
+  }
+  return st;
 }
 
 /* Full enumeration: row i has -1 in column j iff bit (nc-1-j) of i is set. */
@@ -222,7 +245,10 @@ int fesd__model_init(fesd__model *m, const fesd_model *u) {
     m->th_off[k + 1] = m->th_off[k] + nf;
     if (nc > 0) {
       m->S[k] = malloc((size_t)nf * (size_t)nc);
-      if (!m->S[k]) goto fail;
+      if (!m->S[k]) {
+        st = FESD_ERR_NOMEM; /* st holds the last check's FESD_OK from subsystem 1 on */
+        goto fail;
+      }
       if (given)
         memcpy(m->S[k], given, (size_t)nf * (size_t)nc);
       else
@@ -307,27 +333,17 @@ void fesd__point_free(fesd__point_eval *pe) {
 }
 
 static int call_field(fesd__model *m, int k, int i, const double *x, const double *u, double *f) {
-  if (m->user.field(k, i, x, u, f, m->user.user) != 0) {
-    m->failed = "field";
-    return FESD_ERR_CALLBACK;
-  }
-  if (!all_finite(f, m->nr[k])) {
-    m->failed = "field";
-    return FESD_ERR_NONFINITE;
-  }
-  return FESD_OK;
+  mark_unwritten(f, m->nr[k]);
+  int st = m->user.field(k, i, x, u, f, m->user.user) ? FESD_ERR_CALLBACK : check_outputs(f, m->nr[k]);
+  if (st) m->failed = "field";
+  return st;
 }
 
 static int call_switch(fesd__model *m, int k, const double *x, const double *u, double *c) {
-  if (m->user.sw(k, x, u, c, m->user.user) != 0) {
-    m->failed = "switch";
-    return FESD_ERR_CALLBACK;
-  }
-  if (!all_finite(c, m->swr[k])) {
-    m->failed = "switch";
-    return FESD_ERR_NONFINITE;
-  }
-  return FESD_OK;
+  mark_unwritten(c, m->swr[k]);
+  int st = m->user.sw(k, x, u, c, m->user.user) ? FESD_ERR_CALLBACK : check_outputs(c, m->swr[k]);
+  if (st) m->failed = "switch";
+  return st;
 }
 
 /* g^k = -S^k c^k (or the indicators themselves), written to g + th_off[k]. */
@@ -362,15 +378,14 @@ int fesd__model_g(fesd__model *m, const double *x, const double *u, double *g) {
 static int switch_derivatives(fesd__model *m, int k, const double *x, const double *u, int want_u) {
   int nx = m->nx, nu = m->nu, rows = m->swr[k], st;
   if (m->user.sw_jac) {
-    if (m->user.sw_jac(k, x, u, m->dcbuf, want_u ? m->dcubuf : NULL, m->user.user) != 0) {
-      m->failed = "switch_jac";
-      return FESD_ERR_CALLBACK;
-    }
-    if (!all_finite(m->dcbuf, m->sj_nnz[k]) || (want_u && !all_finite(m->dcubuf, rows * nu))) {
-      m->failed = "switch_jac";
-      return FESD_ERR_NONFINITE;
-    }
-    return FESD_OK;
+    const int nu_out = want_u ? rows * nu : 0;
+    mark_unwritten(m->dcbuf, m->sj_nnz[k]);
+    mark_unwritten(m->dcubuf, nu_out);
+    st = m->user.sw_jac(k, x, u, m->dcbuf, want_u ? m->dcubuf : NULL, m->user.user) ? FESD_ERR_CALLBACK : 0;
+    if (!st) st = check_outputs(m->dcbuf, m->sj_nnz[k]);
+    if (!st) st = check_outputs(m->dcubuf, nu_out);
+    if (st) m->failed = "switch_jac";
+    return st;
   }
   memcpy(m->xp, x, (size_t)nx * sizeof(double));
   for (int j = 0; j < nx; j++) {
@@ -434,15 +449,15 @@ static int eval_field_jac(fesd__model *m, int k, int i, int col, const double *x
   double *dfdx = o->dFdx ? o->dFdx + m->dFoff[col] : NULL;
   double *dfdu = (o->dFdu && nu > 0) ? o->dFdu + m->Fuoff[col] : NULL;
   if (m->user.field_jac) {
-    if (m->user.field_jac(k, i, x, u, dfdx ? dfdx : m->jxbuf, dfdu, m->user.user) != 0) {
-      m->failed = "field_jac";
-      return FESD_ERR_CALLBACK;
-    }
-    if ((dfdx && !all_finite(dfdx, m->fj_nnz[k])) || (dfdu && !all_finite(dfdu, m->nr[k] * nu))) {
-      m->failed = "field_jac";
-      return FESD_ERR_NONFINITE;
-    }
-    return FESD_OK;
+    /* only the outputs used are checked (jxbuf takes df/dx when only df/du is wanted) */
+    const int nx_out = dfdx ? m->fj_nnz[k] : 0, nu_out = dfdu ? m->nr[k] * nu : 0;
+    mark_unwritten(dfdx, nx_out);
+    mark_unwritten(dfdu, nu_out);
+    st = m->user.field_jac(k, i, x, u, dfdx ? dfdx : m->jxbuf, dfdu, m->user.user) ? FESD_ERR_CALLBACK : 0;
+    if (!st) st = check_outputs(dfdx, nx_out);
+    if (!st) st = check_outputs(dfdu, nu_out);
+    if (st) m->failed = "field_jac";
+    return st;
   }
   /* dense model: pattern = column-major nx x nx */
   if (dfdx) {

@@ -25,6 +25,7 @@ struct fesd_ncp {
   fesd__ls *active; /* the one used by the current row selection */
   int ready;        /* 0 after a failed re-analysis: solves return FESD_ERR_NOT_READY */
   int rows_pending; /* the selection is set but not applied yet (setup): applied at first use */
+  int nomem;        /* FESD_ERR_NOMEM results of analyses, factorizations and solves so far */
 
   /* row selection */
   unsigned char *eq_on, *pair_mode;
@@ -62,6 +63,12 @@ void fesd__ncp_jt_mul(const fesd_ncp *ws, const double *x, double *y); /* y = J'
 void fesd__ncp_j_mul(const fesd_ncp *ws, const double *x, double *y);  /* y = J x */
 double fesd__ncp_frobenius(const fesd_ncp *ws);
 int fesd__all_finite(const double *x, int n);
+
+/* rc, counted in ws->nomem when it is FESD_ERR_NOMEM (fesd__ncp_nomem_count) */
+static inline int fesd__ncp_note(fesd_ncp *ws, int rc) {
+  if (rc == FESD_ERR_NOMEM) ws->nomem++;
+  return rc;
+}
 
 /* rows.c */
 int fesd__ncp_apply_rows(fesd_ncp *ws);

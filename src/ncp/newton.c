@@ -94,7 +94,7 @@ static int factor_solve(fesd_ncp *ws, fesd__ls *ls, double mu, const double *rhs
     if (rc == FESD_OK && !fesd__all_finite(ws->d, ws->n)) rc = FESD_ERR_SINGULAR;
   }
   st->time_linsolve += fesd__wall_time() - t0;
-  return rc;
+  return fesd__ncp_note(ws, rc);
 }
 
 /* d = -(J'J + mu I)^{-1} g; raises mu when the factorization is not positive definite. */

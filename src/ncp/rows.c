@@ -113,7 +113,7 @@ int fesd__ncp_apply_rows(fesd_ncp *ws) {
     ws->active = ws->lu;
   } else {
     if (!ws->normal) {
-      int rc = fesd__ls_cholmod_create(&ws->normal, n);
+      int rc = fesd__ncp_note(ws, fesd__ls_cholmod_create(&ws->normal, n));
       if (rc != FESD_OK) return rc;
     }
     ws->active = ws->normal;
@@ -153,5 +153,5 @@ int fesd__ncp_apply_rows(fesd_ncp *ws) {
     break;
   }
   if (rc == FESD_OK) ws->ready = 1;
-  return rc;
+  return fesd__ncp_note(ws, rc);
 }

@@ -58,5 +58,5 @@ int fesd_ncp_sensitivity(fesd_ncp *ws, const double *z, double sigma, int nrhs,
     if (rc == FESD_OK && !fesd__all_finite(x, n)) rc = FESD_ERR_SINGULAR;
   }
   st->time_linsolve += fesd__wall_time() - t0;
-  return rc;
+  return fesd__ncp_note(ws, rc);
 }

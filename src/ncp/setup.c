@@ -1,5 +1,6 @@
 /* Settings, validation, workspace allocation, row selection, bounds, cleanup. */
 #include "ncp/ncp_internal.h"
+#include "ncp/ncp_nomem.h"
 
 #include <limits.h>
 #include <math.h>
@@ -24,15 +25,22 @@ int fesd_ncp_settings_default(fesd_ncp_settings *s) {
   return FESD_OK;
 }
 
-static int positive(double x) { return x > 0.0 && isfinite(x); }
-static int in_open_unit(double x, double hi) { return x > 0.0 && x < hi; }
+/* Ranges documented in include/fesd_ncp.h; NaN fails every comparison. The bounds on the
+ * homotopy keep its stage count finite (at most ~420 stages: sigma0 / sigma_min <= 1e19,
+ * factor <= 0.9); lm_mu0 lies in the clamp range of the adapted damping (newton.c). */
+static int in_range(double x, double lo, double hi) { return x >= lo && x <= hi; }
+static int in_open(double x, double lo, double hi) { return x > lo && x < hi; }
+static int int_in(int v, int lo, int hi) { return v >= lo && v <= hi; }
 
 static int validate_settings(const fesd_ncp_settings *s) {
-  if (!positive(s->tol) || s->max_iter < 1 || s->dense_max_n < 0 || s->max_backtracks < 1 ||
-      (int)s->backend < FESD_NCP_BACKEND_AUTO || (int)s->backend > FESD_NCP_BACKEND_CHOLMOD ||
-      !in_open_unit(s->armijo, 0.5) || !in_open_unit(s->backtrack, 1.0) || !positive(s->sigma0) ||
-      !in_open_unit(s->sigma_factor, 1.0) || !positive(s->sigma_min) ||
-      s->sigma_min > s->sigma0 || !positive(s->homotopy_tol_factor) || !positive(s->lm_mu0))
+  if (!in_range(s->tol, 1e-16, 1e-1) || !int_in(s->max_iter, 1, 1000) ||
+      !int_in((int)s->backend, FESD_NCP_BACKEND_AUTO, FESD_NCP_BACKEND_CHOLMOD) ||
+      !int_in(s->dense_max_n, 0, 5000) || !in_open(s->armijo, 0.0, 0.5) ||
+      !in_open(s->backtrack, 0.0, 1.0) || !int_in(s->max_backtracks, 1, 100) ||
+      !(s->sigma0 > 0.0 && s->sigma0 <= 1e3) || !(s->sigma_factor > 0.0 && s->sigma_factor <= 0.9) ||
+      !in_range(s->sigma_min, 1e-16, s->sigma0) ||
+      !(s->homotopy_tol_factor > 0.0 && s->homotopy_tol_factor <= 1.0) ||
+      !in_range(s->lm_mu0, 1e-10, 1e10))
     return FESD_ERR_INVALID_ARG;
   return FESD_OK;
 }
@@ -235,3 +243,5 @@ const char *fesd_ncp_backend_name(int backend) {
   default: return "unknown";
   }
 }
+
+int fesd__ncp_nomem_count(const fesd_ncp *ws) { return ws ? ws->nomem : 0; }

@@ -23,7 +23,7 @@ typedef struct {
   double th_min, th_sum_err;  /* min theta and max |sum theta - 1| over all stages */
   int step_of[TU_MAX_EL];
   int n_ev;
-  fesd_event ev[TU_MAX_EV];
+  fesd_event ev[TU_MAX_EV]; /* before/after point into the integrator: not valid after the run */
   int status;
   fesd_stats stats;
   double xT[FESD_PROBLEM_MAX_NX];

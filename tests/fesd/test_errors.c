@@ -18,7 +18,7 @@
 static int fails = 0;
 #define CHECK FESD_TEST_CHECK
 
-/* ---- test model: the oscillator of the paper (DESIGN.md section 5) with a fault injector ---- */
+/* ---- test model: the oscillator of the paper (src/problems/problems.c) with a fault injector ---- */
 enum { CB_FIELD, CB_SWITCH, CB_FIELD_JAC, CB_SWITCH_JAC, CB_N };
 static const char *const cb_name[CB_N] = {"field", "switch", "field_jac", "switch_jac"};
 enum { FAULT_CODE, FAULT_NAN, FAULT_INF };
@@ -72,7 +72,7 @@ static fesd_model osc_model(injector *in, int with_jac) {
 static const double X0[2] = {0.36787944117144233, 0}; /* e^-1: crosses the circle at t = 1 */
 #define NSTEP 12
 static const double HSTEP = 1.5 / NSTEP;
-/* exact dx(T)/dx0, T > 1, column-major (DESIGN.md section 5, tests/fesd/test_sensitivity.c) */
+/* exact dx(T)/dx0, T > 1, column-major (as tests/fesd/test_sensitivity.c) */
 static void exact_X(double T, double X[4]) {
   double tau = T - 1, e = exp(tau) * exp(1.0), c = cos(W * tau), s = sin(W * tau);
   double RJ[4] = {c - 2 * W * s, -s - 2 * W * c, s, c};
@@ -85,69 +85,146 @@ static double exact_x(int r, double t) { /* oscillator from X0 (crossing at t = 
 
 /* ---- bad input ---- */
 
+/* One settings field out of its documented range per case (include/fesd_integrator.h,
+ * fesd_ncp.h); a case with expect FESD_OK is a field the integrator ignores. */
+typedef struct {
+  const char *what;
+  int expect;
+} bad_case;
+static const bad_case setting_cases[] = {
+    {"method = 7", FESD_ERR_INVALID_ARG},        {"method = -1", FESD_ERR_INVALID_ARG},
+    {"n_fe = 0", FESD_ERR_INVALID_ARG},          {"n_fe = 1 (FESD)", FESD_ERR_INVALID_ARG},
+    {"n_fe = -3", FESD_ERR_INVALID_ARG},         {"n_fe = 1001", FESD_ERR_INVALID_ARG},
+    {"newton_tol = 0", FESD_ERR_INVALID_ARG},    {"newton_tol = NaN", FESD_ERR_INVALID_ARG},
+    {"newton_tol = 1000", FESD_ERR_INVALID_ARG}, {"newton_tol = 2e-3", FESD_ERR_INVALID_ARG},
+    {"newton_tol = 1e-17", FESD_ERR_INVALID_ARG}, {"newton_tol = Inf", FESD_ERR_INVALID_ARG},
+    {"cc_tol = -1", FESD_ERR_INVALID_ARG},       {"cc_tol = 0", FESD_ERR_INVALID_ARG},
+    {"cc_tol = 0.1", FESD_ERR_INVALID_ARG},      {"cc_tol = NaN", FESD_ERR_INVALID_ARG},
+    {"active_tol = 0", FESD_ERR_INVALID_ARG},    {"active_tol = 0.5", FESD_ERR_INVALID_ARG},
+    {"active_tol = NaN", FESD_ERR_INVALID_ARG},  {"max_iter = 0", FESD_ERR_INVALID_ARG},
+    {"max_iter = 1001", FESD_ERR_INVALID_ARG},   {"max_iter_first = 0", FESD_ERR_INVALID_ARG},
+    {"max_iter_first = 1001", FESD_ERR_INVALID_ARG}, {"exit_rows = 2", FESD_ERR_INVALID_ARG},
+    {"exit_rows = -1", FESD_ERR_INVALID_ARG},    {"sensitivities = 2", FESD_ERR_INVALID_ARG},
+    {"sensitivities = -1", FESD_ERR_INVALID_ARG}, {"max_splits = -1", FESD_ERR_INVALID_ARG},
+    {"max_splits = 13", FESD_ERR_INVALID_ARG},   {"max_sweeps = 0", FESD_ERR_INVALID_ARG},
+    {"max_sweeps = 51", FESD_ERR_INVALID_ARG},   {"stages = 0", FESD_ERR_UNSUPPORTED_TABLEAU},
+    {"stages = 13", FESD_ERR_UNSUPPORTED_TABLEAU}, {"Lobatto IIIA s = 1", FESD_ERR_UNSUPPORTED_TABLEAU},
+    {"explicit s = 5", FESD_ERR_UNSUPPORTED_TABLEAU}, {"family = 9", FESD_ERR_UNSUPPORTED_TABLEAU},
+    {"ncp.backend = 17", FESD_ERR_INVALID_ARG},  {"ncp.dense_max_n = 5001", FESD_ERR_INVALID_ARG},
+    {"ncp.armijo = 0.5", FESD_ERR_INVALID_ARG},  {"ncp.backtrack = NaN", FESD_ERR_INVALID_ARG},
+    {"ncp.max_backtracks = 101", FESD_ERR_INVALID_ARG}, {"ncp.sigma0 = 1e4", FESD_ERR_INVALID_ARG},
+    {"ncp.sigma_factor = 0.95", FESD_ERR_INVALID_ARG}, {"ncp.sigma_min = 1e-17", FESD_ERR_INVALID_ARG},
+    {"ncp.homotopy_tol_factor = 2", FESD_ERR_INVALID_ARG}, {"ncp.lm_mu0 = 1e11", FESD_ERR_INVALID_ARG},
+    {"ncp.lm_mu0 = NaN", FESD_ERR_INVALID_ARG},
+    {"ncp.tol = -1 (ignored: newton_tol)", FESD_OK}, {"ncp.max_iter = 0 (ignored: max_iter)", FESD_OK}};
+
+static void break_setting(int k, fesd_settings *s) {
+  switch (k) { /* in the order of setting_cases */
+  case 0: s->method = (fesd_method)7; break;
+  case 1: s->method = (fesd_method)-1; break;
+  case 2: s->n_fe = 0; break;
+  case 3: s->n_fe = 1; break;
+  case 4: s->n_fe = -3; break;
+  case 5: s->n_fe = 1001; break;
+  case 6: s->newton_tol = 0; break;
+  case 7: s->newton_tol = NAN; break;
+  case 8: s->newton_tol = 1000; break;
+  case 9: s->newton_tol = 2e-3; break;
+  case 10: s->newton_tol = 1e-17; break;
+  case 11: s->newton_tol = INFINITY; break;
+  case 12: s->cc_tol = -1; break;
+  case 13: s->cc_tol = 0; break;
+  case 14: s->cc_tol = 0.1; break;
+  case 15: s->cc_tol = NAN; break;
+  case 16: s->active_tol = 0; break;
+  case 17: s->active_tol = 0.5; break;
+  case 18: s->active_tol = NAN; break;
+  case 19: s->max_iter = 0; break;
+  case 20: s->max_iter = 1001; break;
+  case 21: s->max_iter_first = 0; break;
+  case 22: s->max_iter_first = 1001; break;
+  case 23: s->exit_rows = 2; break;
+  case 24: s->exit_rows = -1; break;
+  case 25: s->sensitivities = 2; break;
+  case 26: s->sensitivities = -1; break;
+  case 27: s->max_splits = -1; break;
+  case 28: s->max_splits = 13; break;
+  case 29: s->max_sweeps = 0; break;
+  case 30: s->max_sweeps = 51; break;
+  case 31: s->stages = 0; break;
+  case 32: s->stages = 13; break;
+  case 33: s->family = FESD_RK_LOBATTO_IIIA, s->stages = 1; break;
+  case 34: s->family = FESD_RK_EXPLICIT, s->stages = 5; break;
+  case 35: s->family = (fesd_rk_family)9; break;
+  case 36: s->ncp.backend = (fesd_ncp_backend)17; break;
+  case 37: s->ncp.dense_max_n = 5001; break;
+  case 38: s->ncp.armijo = 0.5; break;
+  case 39: s->ncp.backtrack = NAN; break;
+  case 40: s->ncp.max_backtracks = 101; break;
+  case 41: s->ncp.sigma0 = 1e4; break;
+  case 42: s->ncp.sigma_factor = 0.95; break;
+  case 43: s->ncp.sigma_min = 1e-17; break;
+  case 44: s->ncp.homotopy_tol_factor = 2; break;
+  case 45: s->ncp.lm_mu0 = 1e11; break;
+  case 46: s->ncp.lm_mu0 = NAN; break;
+  case 47: s->ncp.tol = -1; break;
+  default: s->ncp.max_iter = 0; break;
+  }
+}
+
 static void bad_settings(void) {
   injector in = {0};
   fesd_model m = osc_model(&in, 1);
   fesd_settings d;
   CHECK(fesd_settings_default(NULL) == FESD_ERR_NULL, "settings_default(NULL)");
   fesd_settings_default(&d);
-  struct {
-    const char *what;
-    int expect;
-  } cases[] = {{"method = 7", FESD_ERR_INVALID_ARG},       {"n_fe = 0", FESD_ERR_INVALID_ARG},
-               {"n_fe = 1 (FESD)", FESD_ERR_INVALID_ARG},   {"n_fe = -3", FESD_ERR_INVALID_ARG},
-               {"newton_tol = 0", FESD_ERR_INVALID_ARG},    {"newton_tol = NaN", FESD_ERR_INVALID_ARG},
-               {"cc_tol = -1", FESD_ERR_INVALID_ARG},       {"active_tol = 0", FESD_ERR_INVALID_ARG},
-               {"max_iter = 0", FESD_ERR_INVALID_ARG},      {"max_iter_first = 0", FESD_ERR_INVALID_ARG},
-               {"max_splits = -1", FESD_ERR_INVALID_ARG},   {"max_splits = 13", FESD_ERR_INVALID_ARG},
-               {"stages = 0", FESD_ERR_UNSUPPORTED_TABLEAU}, {"stages = 13", FESD_ERR_UNSUPPORTED_TABLEAU},
-               {"Lobatto IIIA s = 1", FESD_ERR_UNSUPPORTED_TABLEAU},
-               {"explicit s = 5", FESD_ERR_UNSUPPORTED_TABLEAU},
-               {"family = 9", FESD_ERR_UNSUPPORTED_TABLEAU}, {"ncp.tol = -1", FESD_ERR_INVALID_ARG},
-               {"ncp.backend = 17", FESD_ERR_INVALID_ARG}};
-  const int n = (int)(sizeof cases / sizeof cases[0]);
+  const int n = (int)(sizeof setting_cases / sizeof setting_cases[0]);
+  int rejected = 0;
   for (int k = 0; k < n; k++) {
     fesd_settings s = d;
-    switch (k) {
-    case 0: s.method = (fesd_method)7; break;
-    case 1: s.n_fe = 0; break;
-    case 2: s.n_fe = 1; break;
-    case 3: s.n_fe = -3; break;
-    case 4: s.newton_tol = 0; break;
-    case 5: s.newton_tol = NAN; break;
-    case 6: s.cc_tol = -1; break;
-    case 7: s.active_tol = 0; break;
-    case 8: s.max_iter = 0; break;
-    case 9: s.max_iter_first = 0; break;
-    case 10: s.max_splits = -1; break;
-    case 11: s.max_splits = 13; break;
-    case 12: s.stages = 0; break;
-    case 13: s.stages = 13; break;
-    case 14: s.family = FESD_RK_LOBATTO_IIIA, s.stages = 1; break;
-    case 15: s.family = FESD_RK_EXPLICIT, s.stages = 5; break;
-    case 16: s.family = (fesd_rk_family)9; break;
-    case 17: s.ncp.tol = -1; break; /* overridden by newton_tol: must still pass */
-    default: s.ncp.backend = (fesd_ncp_backend)17; break;
-    }
+    break_setting(k, &s);
     fesd_integrator *it = (fesd_integrator *)&s; /* must be reset to NULL on failure */
     int st = fesd_create(&it, &m, &s);
-    int expect = k == 17 ? FESD_OK : cases[k].expect;
-    CHECK(st == expect && (st != FESD_OK) == (it == NULL), "settings %s: %s (expected %s)", cases[k].what,
-          fesd_status_name(st), fesd_status_name(expect));
+    const int expect = setting_cases[k].expect;
+    rejected += expect != FESD_OK;
+    CHECK(st == expect && (st != FESD_OK) == (it == NULL), "settings %s: %s (expected %s)",
+          setting_cases[k].what, fesd_status_name(st), fesd_status_name(expect));
     CHECK(st == FESD_OK || strcmp(fesd_status_string(st), "unknown status"), "no message for %d", st);
     fesd_free(&it);
   }
-  /* N_FE = 1 is fine for the standard method; a NULL settings pointer means the defaults */
+  /* the ends of the ranges are accepted */
+  for (int end = 0; end < 2; end++) {
+    fesd_settings s = d;
+    s.newton_tol = end ? 1e-3 : 1e-16;
+    s.cc_tol = end ? 1e-2 : 1e-300;
+    s.active_tol = end ? 0.1 : 1e-300;
+    s.max_iter = s.max_iter_first = end ? 1000 : 1;
+    s.max_splits = end ? 12 : 0;
+    s.max_sweeps = end ? 50 : 1;
+    s.exit_rows = s.sensitivities = end;
+    fesd_integrator *it;
+    int st = fesd_create(&it, &m, &s);
+    CHECK(st == FESD_OK && it, "settings at the %s ends of their ranges: %s", end ? "upper" : "lower",
+          fesd_status_name(st));
+    fesd_free(&it);
+  }
+  /* N_FE = 1000 (with max_splits = 0: the element records hold N_FE 2^max_splits elements) */
   fesd_settings s = d;
-  s.method = FESD_METHOD_STANDARD, s.n_fe = 1;
+  s.n_fe = 1000, s.max_splits = 0;
   fesd_integrator *it;
+  CHECK(fesd_create(&it, &m, &s) == FESD_OK, "N_FE = 1000");
+  fesd_free(&it);
+  /* N_FE = 1 is fine for the standard method; a NULL settings pointer means the defaults */
+  s = d;
+  s.method = FESD_METHOD_STANDARD, s.n_fe = 1;
   CHECK(fesd_create(&it, &m, &s) == FESD_OK, "standard method with N_FE = 1");
   fesd_free(&it);
   CHECK(fesd_create(&it, &m, NULL) == FESD_OK && it, "NULL settings = defaults");
   fesd_free(&it);
   fesd_free(&it); /* already NULL */
   fesd_free(NULL);
-  printf("settings: %d invalid settings rejected\n", n - 1);
+  printf("settings: %d invalid settings rejected, %d ignored ones accepted, range ends accepted\n", rejected,
+         n - rejected);
 }
 
 static void bad_models(void) {

@@ -20,7 +20,11 @@ static void settings_errors(const fesd_ncp_problem *p) {
       "armijo = 0",     "armijo = 0.5",     "backtrack = 0",      "backtrack = 1",
       "max_backtracks = 0", "sigma0 = 0",   "sigma_factor = 1",   "sigma_factor = 0",
       "sigma_min = 0",  "sigma_min > sigma0", "homotopy_tol_factor = 0", "lm_mu0 = 0",
-      "lm_mu0 = -1"};
+      "lm_mu0 = -1",    "tol = 1",          "tol = 1e-17",        "max_iter = 1001",
+      "dense_max_n = 5001", "armijo = NaN", "backtrack = NaN",    "max_backtracks = 101",
+      "sigma0 = 1e4",   "sigma0 = NaN",     "sigma_factor = 0.95", "sigma_factor = NaN",
+      "sigma_min = 1e-17", "sigma_min = NaN", "homotopy_tol_factor = 2", "homotopy_tol_factor = NaN",
+      "lm_mu0 = 1e11",  "lm_mu0 = 1e-11",   "lm_mu0 = NaN"};
   const size_t nbad = sizeof bad / sizeof bad[0];
   for (size_t k = 0; k < nbad; k++) {
     fesd_ncp_settings s = d;
@@ -45,7 +49,25 @@ static void settings_errors(const fesd_ncp_problem *p) {
     case 17: s.sigma_min = 1; break;
     case 18: s.homotopy_tol_factor = 0; break;
     case 19: s.lm_mu0 = 0; break;
-    default: s.lm_mu0 = -1; break;
+    case 20: s.lm_mu0 = -1; break;
+    case 21: s.tol = 1; break;
+    case 22: s.tol = 1e-17; break;
+    case 23: s.max_iter = 1001; break;
+    case 24: s.dense_max_n = 5001; break;
+    case 25: s.armijo = NAN; break;
+    case 26: s.backtrack = NAN; break;
+    case 27: s.max_backtracks = 101; break;
+    case 28: s.sigma0 = 1e4; break;
+    case 29: s.sigma0 = NAN; break;
+    case 30: s.sigma_factor = 0.95; break;
+    case 31: s.sigma_factor = NAN; break;
+    case 32: s.sigma_min = 1e-17; break;
+    case 33: s.sigma_min = NAN; break;
+    case 34: s.homotopy_tol_factor = 2; break;
+    case 35: s.homotopy_tol_factor = NAN; break;
+    case 36: s.lm_mu0 = 1e11; break;
+    case 37: s.lm_mu0 = 1e-11; break;
+    default: s.lm_mu0 = NAN; break;
     }
     fesd_ncp *ws = (fesd_ncp *)&s; /* must be reset to NULL on error */
     int rc = fesd_ncp_setup(&ws, p, &s);
@@ -56,7 +78,24 @@ static void settings_errors(const fesd_ncp_problem *p) {
     CHECK(fesd_ncp_update_settings(ok, &s) == FESD_ERR_INVALID_ARG, "update with %s", bad[k]);
     fesd_ncp_free(&ok);
   }
-  printf("  %zu invalid settings rejected by setup and update_settings\n", nbad);
+  /* the ends of the ranges are accepted */
+  for (int end = 0; end < 2; end++) {
+    fesd_ncp_settings s = d;
+    s.tol = end ? 1e-1 : 1e-16;
+    s.max_iter = end ? 1000 : 1;
+    s.dense_max_n = end ? 5000 : 0;
+    s.max_backtracks = end ? 100 : 1;
+    s.sigma0 = end ? 1e3 : 1e-16;
+    s.sigma_factor = end ? 0.9 : 1e-300;
+    s.sigma_min = end ? 1e3 : 1e-16;
+    s.homotopy_tol_factor = end ? 1 : 1e-300;
+    s.lm_mu0 = end ? 1e10 : 1e-10;
+    fesd_ncp *ws = NULL;
+    CHECK(fesd_ncp_setup(&ws, p, &s) == FESD_OK && ws, "settings at the %s ends of their ranges",
+          end ? "upper" : "lower");
+    fesd_ncp_free(&ws);
+  }
+  printf("  %zu invalid settings rejected by setup and update_settings; range ends accepted\n", nbad);
 }
 
 static int dummy_eval(const double *z, double *raw, double *jac, void *user) {
