@@ -175,6 +175,20 @@ FESD_API int fesd_ncp_set_rows(fesd_ncp *ws, const unsigned char *eq_active,
                                const unsigned char *pair_mode);
 
 /**
+ * @brief Optional border for the sparse LU (KLU backend, square selections): the unknowns with
+ *        col_border[j] != 0 and the assembled rows that come from raw rows with
+ *        raw_border[r] != 0 are eliminated last by a Schur complement (dense, one KLU solve per
+ *        border column). For systems where a few rows and columns couple everything (FESD:
+ *        element lengths, boundary rows): the rest stays block triangular and its factorization
+ *        linear in the size. Used by the selections that have as many border rows as border
+ *        columns; the others (and the other backends) factorize as before. Either NULL removes
+ *        the border. Takes effect at the next fesd_ncp_set_rows().
+ * @return FESD_OK, FESD_ERR_NULL, FESD_ERR_NOMEM.
+ */
+FESD_API int fesd_ncp_set_border(fesd_ncp *ws, const unsigned char *raw_border,
+                                 const unsigned char *col_border);
+
+/**
  * @brief Optional box on the unknowns: the initial guess and every trial point are
  *        projected onto [lb, ub] (a safeguard, e.g. element lengths > 0). A NULL lb / ub
  *        means -inf / +inf; both NULL remove the box. FESD_ERR_INVALID_ARG if lb > ub or NaN.

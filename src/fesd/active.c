@@ -6,6 +6,7 @@
  * difference of indicators along the computed trajectory, theta of an active mode a
  * smooth sliding multiplier; their linear zero crossing predicts the switch time. */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "fesd/step.h"
@@ -141,6 +142,26 @@ void fesd__impose_active(fesd_integrator *it, double *z, const unsigned char *ac
   }
 }
 
+/* Border of the sparse LU (fesd_ncp_set_border): the element lengths, the boundary rows and
+ * sum h = T couple all elements; without them the step matrix is block lower triangular in
+ * time (element n depends on element n - 1 only through x_n). A pinned exit has no boundary
+ * row: the second row of its pinned pair takes that place. */
+int fesd__set_border(fesd_integrator *it) {
+  if (getenv("NOBORDER")) return fesd_ncp_set_border(it->ncp, NULL, NULL);
+  fesd__system *S = &it->sys;
+  memset(it->raw_border, 0, (size_t)S->n_raw);
+  memset(it->col_border, 0, (size_t)S->n);
+  for (int n = 0; n < S->N; n++) it->col_border[S->ho[n]] = 1;
+  for (int k = 1; k < S->N; k++) {
+    if (it->eq_active[fesd__rowH(S, k)]) it->raw_border[fesd__rowH(S, k)] = 1;
+    if (it->eq_active[fesd__rowC(S, k)]) it->raw_border[fesd__rowC(S, k)] = 1;
+  }
+  it->raw_border[S->rT] = 1;
+  for (int p = 0; p < S->n_pair; p++)
+    if (it->pair_mode[p] == FESD_NCP_PAIR_PIN) it->raw_border[S->n_eq + S->n_pair + p] = 1;
+  return fesd_ncp_set_border(it->ncp, it->raw_border, it->col_border);
+}
+
 /* Rows for fixed active sets: pairs A (theta = 0) or B (lambda = 0) per stage;
  * boundary k: bmode[k] = 0 -> h_k = h_{k-1}; 1 -> cross-complementarity row;
  * 2 -> sliding exit of mode exit_mode[k]: the pair of its last stage before the boundary
@@ -161,6 +182,7 @@ int fesd__rows_active(fesd_integrator *it, const unsigned char *act, const int *
             act[(size_t)(n * S->s + j) * S->nth + i] ? FESD_NCP_PAIR_B : FESD_NCP_PAIR_A;
   for (int k = 1; k < S->N; k++)
     if (bmode && bmode[k] == 2) it->pair_mode[fesd__pair(S, k - 1, S->s - 1, exit_mode[k])] = FESD_NCP_PAIR_PIN;
-  return fesd_ncp_set_rows(it->ncp, it->eq_active, it->pair_mode);
+  int st = fesd__set_border(it);
+  return st ? st : fesd_ncp_set_rows(it->ncp, it->eq_active, it->pair_mode);
 }
 

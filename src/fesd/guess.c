@@ -169,6 +169,15 @@ static void stage_theta(fesd_integrator *it, const fesd__point_eval *pe, const u
     for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) cnt += a[i];
     for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) th[i] = a[i] ? 1.0 / cnt : 0.0;
   }
+  int any = 0;
+  for (int k = 0; k < m->nsys && !any; k++) {
+    int cnt = 0;
+    for (int l = m->th_off[k]; l < m->th_off[k + 1]; l++) cnt += a[l];
+    any = cnt == 2;
+  }
+  if (!any) return;
+  double *ftot = it->ftot;
+  fesd__total_field(it, pe, th, ftot);
   for (int k = 0; k < m->nsys; k++) {
     int i = -1, j = -1, cnt = 0;
     for (int l = m->th_off[k]; l < m->th_off[k + 1]; l++)
@@ -178,10 +187,13 @@ static void stage_theta(fesd_integrator *it, const fesd__point_eval *pe, const u
       }
     if (cnt != 2) continue;
     double ai, aj;
-    fesd__normal_components(it, pe, th, i, j, &ai, &aj);
+    fesd__normal_components(it, pe, th, ftot, i, j, &ai, &aj);
     if (ai > 0 && aj < 0) { /* a sliding mode at this point */
-      th[i] = -aj / (ai - aj);
-      th[j] = ai / (ai - aj);
+      const double ti = -aj / (ai - aj), tj = ai / (ai - aj);
+      fesd__F_axpy(m, pe, i, ti - th[i], ftot);
+      fesd__F_axpy(m, pe, j, tj - th[j], ftot);
+      th[i] = ti;
+      th[j] = tj;
     }
   }
 }

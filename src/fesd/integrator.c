@@ -67,7 +67,7 @@ void fesd_free(fesd_integrator **itp) {
                     it->zpred, it->zp, it->raw,       it->lb,    it->ub,     it->Sx,    it->Su,
                     it->Dtmp, it->Stmp, it->gbuf,     it->blk,   it->vtmp,   it->pt_t,  it->pt_q,
                     it->pt_l, it->rec_h, it->rec_t,   it->rec_x, it->rec_th, it->rec_la, it->rec_mu,
-                    it->rec_v, it->zfast, it->bt};
+                    it->rec_v, it->zfast, it->bt, it->ftot, it->gdense, it->bseg_lo, it->bseg_hi, it->hlo, it->hhi};
   for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); i++) free(bufs[i]);
   for (fesd__saved *b = &it->bk; b <= &it->bk_sub; b++) {
     double *saved[] = {b->x, b->lam, b->th, b->blk, b->Sx, b->Su, b->ldp};
@@ -75,7 +75,7 @@ void fesd_free(fesd_integrator **itp) {
   }
   void *other[] = {it->eq_active, it->pair_mode, it->pt_src, it->kb,   it->sw_at,    it->act,
                    it->act0,      it->cand,      it->swap_set, it->bmode, it->exit_mode, it->jump_in,
-                   it->jump_out,  it->scan_buf,  it->plan,   it->plan_after, it->bseg, it->ev_pool};
+                   it->jump_out,  it->scan_buf,  it->plan,   it->plan_after, it->bseg, it->ev_pool, it->raw_border, it->col_border};
   for (size_t i = 0; i < sizeof(other) / sizeof(other[0]); i++) free(other[i]);
   free(it);
   *itp = NULL;
@@ -209,14 +209,22 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   it->gbuf = dalloc(nth + nx, &fail);
   it->blk = dalloc((size_t)S->sb, &fail);
   it->vtmp = dalloc(2 * nx, &fail);
+  it->ftot = dalloc(nx, &fail);
+  it->gdense = dalloc(nx, &fail); /* calloc: zero */
   if (fesd__point_alloc(&it->model, &it->pscr, 1)) fail = 1;
   it->pt_t = dalloc(N * (s + 1) + 1, &fail);
   it->pt_q = dalloc((N * (s + 1) + 1) * nth, &fail);
   it->pt_l = dalloc((N * (s + 1) + 1) * nth, &fail);
   it->zfast = dalloc(n, &fail);
   it->bt = dalloc(cp + 2, &fail);
+  it->bseg_lo = dalloc(cp + 2, &fail);
+  it->bseg_hi = dalloc(cp + 2, &fail);
+  it->hlo = dalloc(N, &fail);
+  it->hhi = dalloc(N, &fail);
   it->eq_active = malloc((size_t)S->n_eq);
   it->pair_mode = malloc((size_t)(S->n_pair > 0 ? S->n_pair : 1));
+  it->raw_border = malloc((size_t)S->n_raw);
+  it->col_border = malloc(n);
   it->pt_src = malloc((N * (s + 1) + 1) * sizeof(int));
   it->kb = malloc((cp + N + 2) * sizeof(int));
   it->sw_at = malloc((N + 1) * sizeof(int));
@@ -239,7 +247,8 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   it->ev_pool = malloc(it->ev_cap * sizeof(int));
   if (fail || !it->eq_active || !it->pair_mode || !it->pt_src || !it->kb || !it->sw_at || !it->act ||
       !it->act0 || !it->cand || !it->swap_set || !it->bmode || !it->exit_mode || !it->jump_in ||
-      !it->jump_out || !it->scan_buf || !it->plan || !it->plan_after || !it->bseg || !it->ev_pool) {
+      !it->jump_out || !it->scan_buf || !it->plan || !it->plan_after || !it->bseg || !it->ev_pool ||
+      !it->raw_border || !it->col_border) {
     fesd_free(&it);
     return FESD_ERR_NOMEM;
   }

@@ -29,6 +29,9 @@ typedef struct {
   int exit;  /* 1: an active mode leaves (its sliding multiplier reached 0): pinned exit row */
   int kb;    /* element boundary carrying it in the current layout */
   int tries; /* active sets tried after it */
+  int fresh; /* added or changed by the last plan update */
+  double lo, hi; /* bracket of its time (the boundary may not leave it: another root of the
+                    same sign change, e.g. the way back of a short excursion) */
 } fesd__switch;
 
 /* A sign violation of a fixed active set, or an invalid sliding mode (verify.c). */
@@ -44,6 +47,8 @@ typedef struct {
                    subsystem (the change itself chose the wrong modes) */
   int filippov; /* the subsystem's 2-mode sliding fails Filippov's conditions here: `mode` is
                    the mode whose field points into its own region (-1: both: repulsive) */
+  double lo, hi; /* bracket of the switch: the last point seen on the right side, the point
+                    where the sign was violated (the trajectory agrees up to the switch) */
 } fesd__violation;
 
 /* A saved state (integrator.c): the step start, restored when fesd_step fails, and the start
@@ -68,11 +73,12 @@ struct fesd_integrator {
   int have_state, have_ws, have_prev_theta;
   /* step data (sized for N_cap elements) */
   double *z, *z0, *zpred, *zp, *raw, *lb, *ub;
-  unsigned char *eq_active, *pair_mode;
+  unsigned char *eq_active, *pair_mode, *raw_border, *col_border;
   fesd__saved bk, bk_sub; /* step start, sub-step start */
   /* sensitivities */
   double *Sx, *Su, *Dtmp, *Stmp;
   double *gbuf, *blk, *vtmp; /* vtmp: 2 nx */
+  double *ftot, *gdense;     /* nx: a total field; a dense gradient kept zero between uses */
   fesd__point_eval pscr;     /* scratch model evaluation */
   double *pt_t, *pt_q, *pt_l; /* switch prediction: point times and q values */
   int *pt_src, *kb, *sw_at;
@@ -92,6 +98,8 @@ struct fesd_integrator {
   double merge_tol; /* switches of different subsystems closer than this share a boundary */
   double *bt;       /* boundary times of the layout (cap_plan + 2) */
   int *bseg;        /* elements per segment (cap_plan + 1) */
+  double *hlo, *hhi; /* bounds of the element lengths of the layout (N_cap) */
+  double *bseg_lo, *bseg_hi; /* per segment (cap_plan + 2) */
   /* records of the last accepted step (grown outside the Newton loop) */
   int cap_el, n_el;
   double *rec_h, *rec_t, *rec_x, *rec_th, *rec_la, *rec_mu, *rec_v;

@@ -108,6 +108,28 @@ int fesd__plan_layout(fesd_integrator *it, double T, double *z) {
       if ((bt[q + 1] - bt[q]) * cnt[best] > (bt[best + 1] - bt[best]) * cnt[q]) best = q;
     cnt[best]++;
   }
+  /* bounds of the element lengths: a fresh switch stays in its bracket, the others move
+   * freely (bt_lo/bt_hi: bounds of the boundary times) */
+  {
+    double lo_prev = 0, hi_prev = 0;
+    int e = 0;
+    for (int q = 0; q <= nb; q++) {
+      double lo_next = T, hi_next = T;
+      if (q < nb) {
+        lo_next = 0, hi_next = T;
+        for (; e < it->n_plan && it->plan[e].kb == q + 1; e++)
+          if (it->plan[e].fresh) {
+            lo_next = lo_next > it->plan[e].lo ? lo_next : it->plan[e].lo;
+            hi_next = hi_next < it->plan[e].hi ? hi_next : it->plan[e].hi;
+          }
+        if (!(lo_next < hi_next)) lo_next = 0, hi_next = T;
+      }
+      double lo = (lo_next - hi_prev) / cnt[q], hi = (hi_next - lo_prev) / cnt[q];
+      it->bseg_lo[q] = lo > 1e-9 * T ? lo : 1e-9 * T;
+      it->bseg_hi[q] = hi < T ? hi : T;
+      lo_prev = lo_next, hi_prev = hi_next;
+    }
+  }
   /* active sets, boundary rows and element lengths */
   unsigned char *cur = it->cand;
   memcpy(cur, it->act0, (size_t)nth);
@@ -127,6 +149,8 @@ int fesd__plan_layout(fesd_integrator *it, double T, double *z) {
     for (int c = 0; c < cnt[q]; c++, n++) {
       for (int j = 0; j < s; j++) memcpy(it->act + (size_t)(n * s + j) * nth, cur, (size_t)nth);
       z[S->ho[n]] = (bt[q + 1] - bt[q]) / cnt[q];
+      it->hlo[n] = it->bseg_lo[q];
+      it->hhi[n] = it->bseg_hi[q];
     }
   }
   return FESD_OK;
@@ -182,7 +206,9 @@ static int enter_set(fesd_integrator *it, const double *z, double t, int k, cons
     int n = 0;
     while (n + 1 < S->N && t >= tn + z[S->ho[n]]) tn += z[S->ho[n++]];
     double ai, aj;
-    fesd__normal_components(it, &pe, z + fesd__th(S, n, 0), i_old, j, &ai, &aj);
+    const double *th = z + fesd__th(S, n, 0);
+    fesd__total_field(it, &pe, th, it->ftot);
+    fesd__normal_components(it, &pe, th, it->ftot, i_old, j, &ai, &aj);
     cross = aj > 0;
   }
   for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) out[i] = cross ? i == j : (P[i] || i == j);
@@ -232,6 +258,7 @@ static int update_one(fesd_integrator *it, const double *z, const fesd__violatio
     }
     if (++it->plan[e].tries > MAX_TRIES || !memcmp(after(it, e) + a, ns + a, (size_t)(b - a))) return 0;
     memcpy(after(it, e) + a, ns + a, (size_t)(b - a));
+    it->plan[e].fresh = 1;
     drop_after(it, k, it->plan[e].t);
     return 1;
   }
@@ -242,6 +269,7 @@ static int update_one(fesd_integrator *it, const double *z, const fesd__violatio
     unsigned char *A = after(it, e);
     if (++w->tries > MAX_TRIES || A[v->mode] == (unsigned char)v->enter) return 0;
     A[v->mode] = (unsigned char)v->enter;
+    w->fresh = 1;
     if (empty_set(it, A, k)) return 0;
     drop_after(it, k, w->t);
     return 1;
@@ -270,6 +298,9 @@ static int update_one(fesd_integrator *it, const double *z, const fesd__violatio
   w->exit = !v->enter;
   w->kb = -1;
   w->tries = 0;
+  w->fresh = 1;
+  w->lo = v->lo;
+  w->hi = v->hi;
   memcpy(after(it, it->n_plan) + a, ns + a, (size_t)(b - a));
   it->n_plan++;
   return 1;
@@ -278,6 +309,7 @@ static int update_one(fesd_integrator *it, const double *z, const fesd__violatio
 int fesd__plan_update(fesd_integrator *it, const double *z, const fesd__violation *per_sys) {
   const double T = it->sys.T;
   int changed = 0;
+  for (int e = 0; e < it->n_plan; e++) it->plan[e].fresh = 0;
   for (int k = 0; k < it->nsys; k++) {
     if (!per_sys[k].found) continue;
     int r = update_one(it, z, &per_sys[k], T);
@@ -286,4 +318,28 @@ int fesd__plan_update(fesd_integrator *it, const double *z, const fesd__violatio
     changed = 1;
   }
   return changed;
+}
+
+int fesd__plan_retreat(fesd_integrator *it) {
+  int nf = 0;
+  for (int e = 0; e < it->n_plan; e++) nf += it->plan[e].fresh;
+  if (nf < 2) return 0;
+  sort_plan(it);
+  /* keep the earlier half of the fresh switches (at least one) */
+  int keep = nf / 2, seen = 0;
+  for (int e = 0; e < it->n_plan; e++)
+    if (it->plan[e].fresh && seen++ >= keep) it->plan[e].fresh = 2;
+  for (int e = it->n_plan - 1; e >= 0; e--)
+    if (it->plan[e].fresh == 2) remove_switch(it, e);
+  return 1;
+}
+
+double fesd__plan_cut_after_fresh(fesd_integrator *it) {
+  sort_plan(it);
+  for (int e = 0; e < it->n_plan; e++)
+    if (it->plan[e].fresh) {
+      const double next = e + 1 < it->n_plan ? it->plan[e + 1].t : it->sys.T;
+      return 0.5 * (it->plan[e].t + next);
+    }
+  return it->sys.T;
 }

@@ -33,6 +33,12 @@ static int hard_failure(int st) {
 
 /* Plan rounds of one step attempt (each one smooth solve). */
 #define MAX_ROUNDS 24
+/* Newton iterations of a plan solve: a plan with the right active sets converges in a few (it
+ * is smooth, from a regridded converged solution); one that does not is changed rather than
+ * iterated on. */
+#define PLAN_ITER 15
+/* Sub-steps cut short after a failed plan solve, per step attempt. */
+#define MAX_SHORTEN 3
 /* A sub-step ends before this many boundaries when the plan holds more (see plan_cut). */
 #define SUB_MARGIN 1
 
@@ -47,18 +53,21 @@ static int rows_select(fesd_integrator *it, const int *switch_at) {
     it->eq_active[fesd__rowC(S, k)] = (unsigned char)(sw != 0);
   }
   memset(it->pair_mode, FESD_NCP_PAIR_FB, (size_t)S->n_pair);
-  return fesd_ncp_set_rows(it->ncp, it->eq_active, it->pair_mode);
+  int st = fesd__set_border(it);
+  return st ? st : fesd_ncp_set_rows(it->ncp, it->eq_active, it->pair_mode);
 }
 
-static int set_h_bounds(fesd_integrator *it, double T) {
+/* Element lengths in [1e-9 T, T], or in the plan's bounds (fesd__plan_layout). */
+static int set_h_bounds(fesd_integrator *it, double T, int plan) {
   fesd__system *S = &it->sys;
   for (int i = 0; i < S->n; i++) {
     it->lb[i] = -INFINITY;
     it->ub[i] = INFINITY;
   }
   for (int n = 0; n < S->N; n++) {
-    it->lb[S->ho[n]] = 1e-9 * T;
-    it->ub[S->ho[n]] = T;
+    if (getenv("NOBOUNDS")) plan = 0;
+    it->lb[S->ho[n]] = plan ? it->hlo[n] : 1e-9 * T;
+    it->ub[S->ho[n]] = plan ? it->hhi[n] : T;
   }
   return fesd_ncp_set_bounds(it->ncp, it->lb, it->ub);
 }
@@ -102,14 +111,27 @@ static int solve(fesd_integrator *it, double *z, double sigma, double tol, int m
     accumulate(info, &ni);
     if (st && getenv("FESD_DEBUG2")) {
       fesd__system_eval(z, it->raw, NULL, S);
-      fprintf(stderr, "failed solve: raw weighted rows:");
-      for (int r = 0; r < S->n_raw; r++) fprintf(stderr, " %d:%.2g(w%.2g)", r, it->raw[r], S->wraw[r]);
-      fprintf(stderr, "\n");
-      double *Fa = it->zpred; /* scratch */
-      fesd_ncp_residual(it->ncp, z, sigma, Fa, NULL);
-      fprintf(stderr, "assembled F:");
-      for (int r = 0; r < fesd_ncp_rows(it->ncp); r++) if (fabs(Fa[r]) > 1e-12) fprintf(stderr, " %d:%.3g", r, Fa[r]);
-      fprintf(stderr, "\n");
+      for (int r = 0; r < S->n_raw; r++) {
+        int used = r < S->n_eq ? it->eq_active[r] : 1;
+        if (r >= S->n_eq) {
+          int pk = (r - S->n_eq) % S->n_pair, bside = r >= S->n_eq + S->n_pair, md = it->pair_mode[pk];
+          used = md == FESD_NCP_PAIR_PIN || (md == FESD_NCP_PAIR_A && !bside) || (md == FESD_NCP_PAIR_B && bside);
+        }
+        if (!used) it->raw[r] = 0.0;
+      }
+      for (int rep = 0; rep < 8; rep++) {
+        int best = -1;
+        for (int r = 0; r < S->n_raw; r++)
+          if ((best < 0 || fabs(it->raw[r]) > fabs(it->raw[best])) && it->raw[r] != 0.0) best = r;
+        if (best < 0) break;
+        const char *ty = "?";
+        int n = -1, j = -1, q = -1;
+        if (best >= S->n_eq) ty = best >= S->n_eq + S->n_pair ? "pairB" : "pairA", q = (best - S->n_eq) % S->n_pair, n = q / (S->s * S->nth), j = (q / S->nth) % S->s, q = q % S->nth;
+        else if (best >= S->rH0) ty = best >= S->rT ? "T" : best >= S->rC0 ? "C" : "H", n = best - S->rH0;
+        else { n = best / S->erows; int o = best % S->erows; if (o < S->s * S->rs) { j = o / S->rs; o %= S->rs; ty = o < S->nx ? "V" : o < S->nx + S->nth ? "G" : "S"; q = o < S->nx ? o : o - S->nx; } else { ty = "X/LB"; q = o - S->s * S->rs; } }
+        fprintf(stderr, "  row %d %s el %d st %d idx %d: %.3g (w %.3g) mode %s\n", best, ty, n, j, q, it->raw[best], S->wraw[best], "");
+        it->raw[best] = 0.0;
+      }
     }
     if (st) break;
     st = FESD_ERR_MAX_ITER;
@@ -244,7 +266,8 @@ static int candidates(fesd_integrator *it, const fesd__violation *v, const unsig
   pe.dgdx = it->pscr.dgdx;
   if (fesd__model_eval(&it->model, x, it->sys.u, &pe)) return 0;
   double ai, aj;
-  fesd__normal_components(it, &pe, theta, i_old, v->mode, &ai, &aj);
+  fesd__total_field(it, &pe, theta, it->ftot);
+  fesd__normal_components(it, &pe, theta, it->ftot, i_old, v->mode, &ai, &aj);
   const int cross = aj > 0;
   for (int i = k0; i < k1; i++) {
     cands[!cross][i - k0] = i == v->mode;          /* crossing: j replaces the set */
@@ -278,9 +301,11 @@ static int std_switch(fesd_integrator *it, fesd__violation v, fesd_step_info *in
       if (st) return st;
       fesd__violation v2;
       st = fixed_solve(it, z, it->set.max_iter, info);
+      if (getenv("FESD_DEBUG")) fprintf(stderr, "std cand %d p0 %d: %s\n", c, p0, fesd_status_name(st));
       if (hard_failure(st)) return st;
       if (st == FESD_OK) {
         if ((st = fesd__scan(it, z, it->act, 1, &v2, NULL))) return st;
+        if (getenv("FESD_DEBUG") && v2.found) fprintf(stderr, "  v2 t=%g mode %d enter %d stage %d\n", v2.t, v2.mode, v2.enter, v2.stage);
         if (!v2.found) {
           info->switch_step = 1; /* the active set changed inside the step */
           return FESD_OK;
@@ -296,12 +321,76 @@ static int std_switch(fesd_integrator *it, fesd__violation v, fesd_step_info *in
   return FESD_ERR_STEP_FAILED;
 }
 
+/* Standard method with an explicit RK tableau: its equations are explicit stage by stage, the
+ * LP at each stage state picks the mode (argmin of the indicators; at an exact tie the mode of
+ * the stage before), so the step is computed forward without Newton. (Solving it with fixed
+ * active sets failed where the state chatters within round-off of a surface: a sliding set
+ * cannot hold at an explicit stage.) */
+static int explicit_std(fesd_integrator *it) {
+  fesd__system *S = &it->sys;
+  fesd__model *m = &it->model;
+  const int nx = S->nx, nth = S->nth, s = S->s;
+  double *z = it->z, *X = S->X, *g = it->pscr.g;
+  fesd__point_eval pe = {0};
+  pe.F = it->pscr.F;
+  pe.g = g;
+  const unsigned char *prev = it->act0;
+  for (int n = 0; n < S->N; n++) {
+    const double h = S->T / S->N, *xn = n == 0 ? S->x0 : z + S->xo[n - 1];
+    z[S->ho[n]] = h;
+    for (int j = 0; j < s; j++) {
+      for (int r = 0; r < nx; r++) {
+        double acc = 0;
+        for (int l = 0; l < j; l++) acc += S->tab.A[j][l] * z[fesd__v(S, n, l) + r];
+        X[r] = xn[r] + h * acc;
+      }
+      int st = fesd__model_eval(m, X, S->u, &pe);
+      if (st) return st;
+      unsigned char *a = it->act + (size_t)(n * s + j) * nth;
+      double *th = z + fesd__th(S, n, j), *la = z + fesd__la(S, n, j), *mu = z + fesd__mu(S, n, j);
+      for (int k = 0; k < m->nsys; k++) {
+        int best = -1;
+        for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++)
+          if (best < 0 || g[i] < g[best] || (g[i] == g[best] && prev[i] && !prev[best])) best = i;
+        mu[k] = g[best];
+        for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) {
+          a[i] = i == best;
+          th[i] = a[i];
+          la[i] = g[i] - g[best];
+        }
+      }
+      fesd__total_field(it, &pe, th, z + fesd__v(S, n, j));
+      prev = a;
+    }
+    for (int r = 0; r < nx; r++) {
+      double acc = 0;
+      for (int j = 0; j < s; j++) acc += S->tab.b[j] * z[fesd__v(S, n, j) + r];
+      z[S->xo[n] + r] = xn[r] + h * acc;
+    }
+    if (S->bp) {
+      int st = fesd__model_g(m, z + S->xo[n], S->u, g);
+      if (st) return st;
+      const double *th = z + fesd__th(S, n, s - 1);
+      double *LB = z + S->lbo[n], *MB = LB + nth;
+      for (int k = 0; k < m->nsys; k++) {
+        MB[k] = 0;
+        for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) MB[k] += th[i] * g[i];
+      }
+      for (int i = 0; i < nth; i++) LB[i] = g[i] - MB[m->sys_of[i]];
+    }
+  }
+  memset(it->bmode, 0, (size_t)(S->N + 1) * sizeof(int));
+  return fesd__rows_active(it, it->act, it->bmode, it->exit_mode);
+}
+
 static int std_path(fesd_integrator *it, fesd_step_info *info) {
+  if (it->tab.is_explicit) return explicit_std(it);
   int st = start_solve(it, info);
   if (getenv("FESD_DEBUG")) fprintf(stderr, "std start solve: %s\n", fesd_status_name(st));
   if (st) return hard_failure(st) ? st : FESD_ERR_STEP_FAILED;
   fesd__violation v;
   if ((st = fesd__scan(it, it->z, it->act, 1, &v, NULL))) return st;
+  if (getenv("FESD_DEBUG") && v.found) fprintf(stderr, "std viol t=%g mode %d enter %d stage %d\n", v.t, v.mode, v.enter, v.stage);
   return v.found ? std_switch(it, v, info) : FESD_OK;
 }
 
@@ -318,7 +407,7 @@ static void shorten(fesd_integrator *it, double *T) {
 static int plan_path(fesd_integrator *it, double *T, fesd_step_info *info) {
   fesd__system *S = &it->sys;
   double *z = it->z, *zp = it->zp;
-  int Np = 0, st;
+  int Np = 0, st, shortened = 0;
   fesd__plan_reset(it);
   if ((st = start_solve(it, info))) return hard_failure(st) ? st : FESD_ERR_STEP_FAILED;
   for (int round = 0;; round++) {
@@ -345,17 +434,28 @@ static int plan_path(fesd_integrator *it, double *T, fesd_step_info *info) {
     }
     if (r < 0) return r;
     if (r == 0) return FESD_ERR_STEP_FAILED;
-    st = fesd__plan_layout(it, S->T, z);
-    if (st == FESD_ERR_TOO_MANY_SWITCHES) {
-      shorten(it, T);
+    for (;;) { /* solve the new plan; retreat to fewer new switches while it fails */
       st = fesd__plan_layout(it, S->T, z);
+      if (st == FESD_ERR_TOO_MANY_SWITCHES) {
+        shorten(it, T);
+        st = fesd__plan_layout(it, S->T, z);
+      }
+      if (st) return st;
+      if ((st = set_h_bounds(it, S->T, 1))) return st;
+      if ((st = fesd__regrid_guess(it, zp, Np, z))) return st;
+      st = fixed_solve(it, z, it->set.max_iter < PLAN_ITER ? it->set.max_iter : PLAN_ITER, info);
+      if (getenv("FESD_DEBUG")) fprintf(stderr, "  solve N=%d: %s res %.2e\n", S->N, fesd_status_name(st), info->residual);
+      if (st == FESD_OK) break;
+      if (hard_failure(st)) return st;
+      if (fesd__plan_retreat(it)) continue;
+      /* one new switch and still no solution: the step may hold more than the plan sees
+       * (the trajectory after the switch differs from the predicting one); end the sub-step
+       * midway between that switch and the next one, where the prediction still holds */
+      const double cut = fesd__plan_cut_after_fresh(it);
+      if (!(cut < S->T) || ++shortened > MAX_SHORTEN) return FESD_ERR_STEP_FAILED;
+      fesd__plan_truncate(it, cut);
+      *T = S->T = cut;
     }
-    if (st) return st;
-    if ((st = set_h_bounds(it, S->T))) return st;
-    if ((st = fesd__regrid_guess(it, zp, Np, z))) return st;
-    st = fixed_solve(it, z, it->set.max_iter, info);
-    if (getenv("FESD_DEBUG")) fprintf(stderr, "  solve N=%d: %s res %.2e\n", S->N, fesd_status_name(st), info->residual);
-    if (st) return hard_failure(st) ? st : FESD_ERR_STEP_FAILED;
   }
 }
 
@@ -373,7 +473,7 @@ static int try_step(fesd_integrator *it, const double *u, double *T, fesd_step_i
   if (st) return st;
   for (int k = 0; k < it->nsys; k++) it->jump_in[k] = it->jump_out[k] = -1;
   if ((st = fesd__initial_guess(it, u, *T, it->z0))) return st;
-  if ((st = set_h_bounds(it, *T))) return st;
+  if ((st = set_h_bounds(it, *T, 0))) return st;
   int nonunique = 0;
   if ((st = fesd__act_start(it, u, it->act0, &nonunique))) return st;
   it->nonunique = nonunique;
@@ -384,7 +484,7 @@ static int try_step(fesd_integrator *it, const double *u, double *T, fesd_step_i
     S->T = T_full;
     for (int k = 0; k < it->nsys; k++) it->jump_in[k] = it->jump_out[k] = -1;
     if ((st = fesd__use_level(it, it->set.n_fe))) return st;
-    if ((st = set_h_bounds(it, *T))) return st;
+    if ((st = set_h_bounds(it, *T, 0))) return st;
     if ((st = fb_path(it, *T, info))) return st;
     info->fallback++;
   }

@@ -19,12 +19,17 @@ void fesd__act_from_theta(const fesd_integrator *it, const double *theta, unsign
  * both sides leave (several Filippov solutions). */
 int fesd__act_start(fesd_integrator *it, const double *u, unsigned char *a, int *nonunique);
 void fesd__impose_active(fesd_integrator *it, double *z, const unsigned char *act);
+/* Border flags of the current layout and rows for the solver (fesd_ncp_set_border). */
+int fesd__set_border(fesd_integrator *it);
 int fesd__rows_active(fesd_integrator *it, const unsigned char *act, const int *bmode,
                       const int *exit_mode);
+/* Total field F theta at an evaluated point (f: nx, dense). */
+void fesd__total_field(fesd_integrator *it, const fesd__point_eval *pe, const double *th, double *f);
 /* Normal components d/dt (g_i - g_j) along the total field with mode i alone and with mode j
- * alone in its subsystem (the other subsystems at theta) at an evaluated point. */
+ * alone in its subsystem (the other subsystems at theta) at an evaluated point; ftot: the total
+ * field at theta (fesd__total_field). */
 void fesd__normal_components(fesd_integrator *it, const fesd__point_eval *pe, const double *theta,
-                             int i, int j, double *ai, double *aj);
+                             const double *ftot, int i, int j, double *ai, double *aj);
 
 /* ---- verify.c ---- */
 /* Earliest violation of the active sets act (N*s blocks) in z over all subsystems (v) and, when
@@ -69,6 +74,12 @@ void fesd__plan_times(fesd_integrator *it, const double *z);
 /* Change the plan for the violations of a scan (per subsystem). Returns 1 if it changed,
  * 0 if nothing can be changed (the caller gives up), or a negative status. */
 int fesd__plan_update(fesd_integrator *it, const double *z, const fesd__violation *per_sys);
+/* A plan whose solve failed after an update that added several switches keeps the earlier
+ * half of them (the later ones were predicted from a trajectory that the earlier ones change).
+ * Returns 1 if it changed the plan, 0 if there is nothing to take back. */
+int fesd__plan_retreat(fesd_integrator *it);
+/* Midway between the earliest fresh switch and the next switch (or T). */
+double fesd__plan_cut_after_fresh(fesd_integrator *it);
 /* Keep only the switches before t (a shorter sub-step). */
 void fesd__plan_truncate(fesd_integrator *it, double t);
 /* Time before which at most n_max switches of the plan lie (the end of a sub-step that holds

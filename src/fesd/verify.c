@@ -152,6 +152,8 @@ static void scan_signs(fesd_integrator *it, const double *z, const unsigned char
           fesd__violation c = {0};
           c.found = 1;
           c.t = isnan(v0) ? tn : (v0 > 0 ? t0 + (t - t0) * v0 / (v0 - val) : t0);
+          c.lo = isnan(v0) ? tn : t0;
+          c.hi = t;
           c.mode = i;
           c.sys = k;
           c.enter = !a;
@@ -171,37 +173,46 @@ static void scan_signs(fesd_integrator *it, const double *z, const unsigned char
   }
 }
 
-/* Total field at an evaluated point with the thetas th, into f (nx). */
-static void total_field(fesd_integrator *it, const fesd__point_eval *pe, const double *th, double *f) {
+void fesd__total_field(fesd_integrator *it, const fesd__point_eval *pe, const double *th, double *f) {
   memset(f, 0, (size_t)it->nx * sizeof(double));
   for (int i = 0; i < it->nth; i++)
     if (th[i] != 0.0) fesd__F_axpy(&it->model, pe, i, th[i], f);
 }
 
+/* O(size of subsystem k's fields and switching functions), not O(n_x): with many subsystems
+ * (a friction chain) a dense copy of the field per subsystem made the checks quadratic. */
 void fesd__normal_components(fesd_integrator *it, const fesd__point_eval *pe, const double *theta,
-                             int i, int j, double *ai, double *aj) {
+                             const double *ftot, int i, int j, double *ai, double *aj) {
   const fesd__model *m = &it->model;
-  const int k = m->sys_of[i];
-  double *f = it->vtmp;
-  total_field(it, pe, theta, f);
-  for (int l = m->th_off[k]; l < m->th_off[k + 1]; l++)
-    if (theta[l] != 0.0) fesd__F_axpy(m, pe, l, -theta[l], f);
-  /* f: the other subsystems' part; add mode i, then replace it by mode j */
-  fesd__F_axpy(m, pe, i, 1.0, f);
-  *ai = fesd__dg_dot(m, pe, i, f) - fesd__dg_dot(m, pe, j, f);
-  fesd__F_axpy(m, pe, i, -1.0, f);
-  fesd__F_axpy(m, pe, j, 1.0, f);
-  *aj = fesd__dg_dot(m, pe, i, f) - fesd__dg_dot(m, pe, j, f);
+  const int k = m->sys_of[i], *cols = m->cols[k], nc = m->ncol[k], *rows = m->rows[k], nr = m->nr[k];
+  double *gd = it->gdense; /* dense grad (g_i - g_j), zero outside this call */
+  fesd__dg_axpy(m, pe, i, 1.0, gd);
+  fesd__dg_axpy(m, pe, j, -1.0, gd);
+  double base = 0;
+  for (int c = 0; c < nc; c++) base += gd[cols[c]] * ftot[cols[c]];
+  double di = 0, dj = 0;
+  for (int l = m->th_off[k]; l < m->th_off[k + 1]; l++) {
+    if (theta[l] == 0.0 && l != i && l != j) continue;
+    const double *f = pe->F + m->Foff[l];
+    double d = 0;
+    for (int r = 0; r < nr; r++) d += gd[rows[r]] * f[r];
+    base -= theta[l] * d;
+    if (l == i) di = d;
+    if (l == j) dj = d;
+  }
+  *ai = base + di;
+  *aj = base + dj;
+  for (int c = 0; c < nc; c++) gd[cols[c]] = 0.0;
 }
 
 /* Filippov's conditions of the 2-mode sliding of subsystem k with modes i, j at an evaluated
  * point: with psi = g_i - g_j (< 0 in region i) sliding needs d psi/dt >= 0 along mode i and
  * <= 0 along mode j. Returns the mode whose field clearly points into its own region (the one
  * that continues), -1 for both (repulsive), -2 for none. */
-static int filippov(fesd_integrator *it, const fesd__point_eval *pe, const double *th, int i, int j,
-                    double rel) {
+static int filippov(fesd_integrator *it, const fesd__point_eval *pe, const double *th, const double *ftot,
+                    int i, int j, double rel) {
   double ai, aj;
-  fesd__normal_components(it, pe, th, i, j, &ai, &aj);
+  fesd__normal_components(it, pe, th, ftot, i, j, &ai, &aj);
   const double tol = rel * (fabs(ai) + fabs(aj));
   const int bad_i = ai < -tol, bad_j = aj > tol;
   if (bad_i && bad_j) return -1;
@@ -252,15 +263,16 @@ static int scan_filippov(fesd_integrator *it, const double *z, const unsigned ch
         int st = fesd__model_eval(m, X, S->u, &pe);
         if (st) return st;
         const double *th = z + fesd__th(S, n, q);
+        fesd__total_field(it, &pe, th, it->ftot);
         for (int k = 0; k < m->nsys; k++) {
           int j, i = two_modes(it, a, k, &j);
           if (i < 0) continue;
           /* the element end where k's set changes is the switch point itself (a sliding exit:
            * the remaining field is tangent there) */
           if (S->tab.c[q] == 1.0 && n + 1 < S->N && set_changes(it, act, n + 1, k)) continue;
-          int c = filippov(it, &pe, th, i, j, FIL_STAGE_TOL);
+          int c = filippov(it, &pe, th, it->ftot, i, j, FIL_STAGE_TOL);
           if (c == -2) continue;
-          fesd__violation v = {1, tn + S->tab.c[q] * h, c < 0 ? i : c, k, 0, n, n * s + q, 0, 1};
+          fesd__violation v = {1, tn + S->tab.c[q] * h, c < 0 ? i : c, k, 0, n, n * s + q, 0, 1, 0, 0};
           v.filippov = c < 0 ? -1 : 1;
           note(&ps[k], &v);
         }
@@ -303,6 +315,7 @@ static int scan_interior(fesd_integrator *it, const double *z, const unsigned ch
       for (int j = 1; j < s; j++)
         if (fabs(S->tab.c[j] - it->mid_tau[p]) < fabs(S->tab.c[jn] - it->mid_tau[p])) jn = j;
       const double *th = z + fesd__th(S, n, jn);
+      if (sliding) fesd__total_field(it, &q, th, it->ftot);
       for (int k = 0; k < m->nsys; k++) {
         double gact = INFINITY, gin = INFINITY;
         int lin = -1;
@@ -311,15 +324,15 @@ static int scan_interior(fesd_integrator *it, const double *z, const unsigned ch
           else if (pe.g[i] < gin) gin = pe.g[i], lin = i;
         }
         if (lin >= 0 && (gin - gact) * S->wG[k] < -INTERIOR_TOL * it->set.cc_tol) {
-          fesd__violation v = {1, t, lin, k, 1, n, n * s + s, 0, 0};
+          fesd__violation v = {1, t, lin, k, 1, n, n * s + s, 0, 0, tn, t};
           note(&ps[k], &v);
           continue;
         }
         int j, i = two_modes(it, a, k, &j);
         if (i < 0 || !sliding) continue;
-        int c = filippov(it, &q, th, i, j, FIL_MID_TOL);
+        int c = filippov(it, &q, th, it->ftot, i, j, FIL_MID_TOL);
         if (c == -2) continue;
-        fesd__violation v = {1, t, c < 0 ? i : c, k, 0, n, n * s + s, 0, c < 0 ? -1 : 1};
+        fesd__violation v = {1, t, c < 0 ? i : c, k, 0, n, n * s + s, 0, c < 0 ? -1 : 1, 0, 0};
         note(&ps[k], &v);
       }
     }

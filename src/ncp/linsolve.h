@@ -47,6 +47,10 @@ int fesd__ls_dense_normal_create(fesd__ls **ls, int n);
 int fesd__ls_umfpack_create(fesd__ls **ls, int n);
 int fesd__ls_klu_create(fesd__ls **ls, int n);
 int fesd__ls_cholmod_create(fesd__ls **ls, int n);
+/* Bordered KLU (ls_border.c): nb rows and columns eliminated last by a Schur complement;
+ * the flags (assembled rows, columns) are read at each analyze and must stay valid. */
+int fesd__ls_border_create(fesd__ls **ls, int n, int nb);
+void fesd__ls_border_flags(fesd__ls *ls, const unsigned char *row_border, const unsigned char *col_border);
 
 static inline void fesd__ls_destroy(fesd__ls **ls) {
   if (ls && *ls) {

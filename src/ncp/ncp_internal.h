@@ -23,6 +23,11 @@ struct fesd_ncp {
   /* linear solvers: square LU (NULL for CHOLMOD) and normal equations (lazy when sparse) */
   fesd__ls *lu, *normal;
   fesd__ls *active; /* the one used by the current row selection */
+  /* border (fesd_ncp_set_border): flags per raw row and unknown, of the assembled rows of the
+   * current selection; the bordered KLU is used when the counts match (square, KLU) */
+  fesd__ls *border;
+  unsigned char *raw_border, *col_border, *row_border;
+  int nb, border_dirty;
   int ready;        /* 0 after a failed re-analysis: solves return FESD_ERR_NOT_READY */
   int rows_pending; /* the selection is set but not applied yet (setup): applied at first use */
   int nomem;        /* FESD_ERR_NOMEM results of analyses, factorizations and solves so far */

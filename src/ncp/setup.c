@@ -49,6 +49,10 @@ void fesd_ncp_free(fesd_ncp **pws) {
   if (!pws || !*pws) return;
   fesd_ncp *ws = *pws;
   fesd__ls_destroy(&ws->lu);
+  fesd__ls_destroy(&ws->border);
+  free(ws->raw_border);
+  free(ws->col_border);
+  free(ws->row_border);
   fesd__ls_destroy(&ws->normal);
   void *arrays[] = {ws->trow,    ws->tcol,     ws->eq_on,   ws->pair_mode, ws->eq_list,
                     ws->pair_pos, ws->fb_list, ws->act_src, ws->act_wrow,  ws->act_tgt,
@@ -209,7 +213,7 @@ int fesd_ncp_set_rows(fesd_ncp *ws, const unsigned char *eq_active,
     same = same && md == ws->pair_mode[k];
   }
   if (m < ws->n) return FESD_ERR_DIMENSION; /* the previous selection stays in force */
-  if (same) return FESD_OK;
+  if (same && !ws->border_dirty) return FESD_OK;
   ws->rows_pending = 0;
   for (int e = 0; e < ws->n_eq; e++) ws->eq_on[e] = eq_active ? (eq_active[e] != 0) : 1;
   for (int k = 0; k < ws->n_pair; k++)
@@ -228,6 +232,43 @@ int fesd_ncp_set_bounds(fesd_ncp *ws, const double *lb, const double *ub) {
     ws->ub[i] = ub ? ub[i] : INFINITY;
   }
   ws->has_box = lb || ub;
+  return FESD_OK;
+}
+
+int fesd_ncp_set_border(fesd_ncp *ws, const unsigned char *raw_border, const unsigned char *col_border) {
+  if (!ws) return FESD_ERR_NULL;
+  /* only the KLU backend uses a border: the others allocate nothing for it */
+  if (!raw_border || !col_border || !ws->lu || ws->lu->backend != FESD_NCP_BACKEND_KLU) {
+    ws->border_dirty |= ws->nb > 0;
+    ws->nb = 0;
+    return FESD_OK;
+  }
+  if (!ws->raw_border) {
+    ws->raw_border = malloc((size_t)ws->n_raw);
+    ws->col_border = malloc((size_t)ws->n);
+    ws->row_border = malloc((size_t)ws->m_max);
+    if (!ws->raw_border || !ws->col_border || !ws->row_border) {
+      free(ws->raw_border), free(ws->col_border), free(ws->row_border);
+      ws->raw_border = ws->col_border = ws->row_border = NULL;
+      return fesd__ncp_note(ws, FESD_ERR_NOMEM);
+    }
+    memset(ws->raw_border, 0, (size_t)ws->n_raw);
+    memset(ws->col_border, 0, (size_t)ws->n);
+  }
+  int nb = 0, changed = 0;
+  for (int j = 0; j < ws->n; j++) {
+    const unsigned char f = col_border[j] != 0;
+    changed |= f != ws->col_border[j];
+    ws->col_border[j] = f;
+    nb += f;
+  }
+  for (int r = 0; r < ws->n_raw; r++) {
+    const unsigned char f = raw_border[r] != 0;
+    changed |= f != ws->raw_border[r];
+    ws->raw_border[r] = f;
+  }
+  ws->border_dirty |= changed || nb != ws->nb;
+  ws->nb = nb;
   return FESD_OK;
 }
 
