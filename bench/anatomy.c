@@ -89,25 +89,25 @@ typedef struct {
   long calls[4]; /* field, field_jac, sw, sw_jac */
 } count_model;
 
-static int c_field(int sys, int mode, const double *x, const double *u, double *f, void *user) {
+static int c_field(int sys, int mode, double t, const double *x, const double *u, double *f, void *user) {
   count_model *w = user;
   w->calls[0]++;
-  return w->m.field(sys, mode, x, u, f, w->m.user);
+  return w->m.field(sys, mode, t, x, u, f, w->m.user);
 }
-static int c_field_jac(int sys, int mode, const double *x, const double *u, double *dx, double *du, void *user) {
+static int c_field_jac(int sys, int mode, double t, const double *x, const double *u, double *dx, double *du, void *user) {
   count_model *w = user;
   w->calls[1]++;
-  return w->m.field_jac(sys, mode, x, u, dx, du, w->m.user);
+  return w->m.field_jac(sys, mode, t, x, u, dx, du, w->m.user);
 }
-static int c_sw(int sys, const double *x, const double *u, double *c, void *user) {
+static int c_sw(int sys, double t, const double *x, const double *u, double *c, void *user) {
   count_model *w = user;
   w->calls[2]++;
-  return w->m.sw(sys, x, u, c, w->m.user);
+  return w->m.sw(sys, t, x, u, c, w->m.user);
 }
-static int c_sw_jac(int sys, const double *x, const double *u, double *dx, double *du, void *user) {
+static int c_sw_jac(int sys, double t, const double *x, const double *u, double *dx, double *du, void *user) {
   count_model *w = user;
   w->calls[3]++;
-  return w->m.sw_jac(sys, x, u, dx, du, w->m.user);
+  return w->m.sw_jac(sys, t, x, u, dx, du, w->m.user);
 }
 
 typedef struct {
@@ -123,10 +123,10 @@ static int call_loop(void *ctx) { /* 1000 calls of one callback kind at x0 (subs
   double *du = m->nu ? c->out_u : NULL;
   int rc = 0;
   for (int r = 0; r < 1000; r++) {
-    if (c->kind == 0) rc |= m->field(0, 0, x, u, c->out, m->user);
-    else if (c->kind == 1) rc |= m->field_jac(0, 0, x, u, c->out, du, m->user);
-    else if (c->kind == 2) rc |= m->sw(0, x, u, c->out, m->user);
-    else rc |= m->sw_jac(0, x, u, c->out, du, m->user);
+    if (c->kind == 0) rc |= m->field(0, 0, 0.0, x, u, c->out, m->user);
+    else if (c->kind == 1) rc |= m->field_jac(0, 0, 0.0, x, u, c->out, du, m->user);
+    else if (c->kind == 2) rc |= m->sw(0, 0.0, x, u, c->out, m->user);
+    else rc |= m->sw_jac(0, 0.0, x, u, c->out, du, m->user);
   }
   return rc;
 }

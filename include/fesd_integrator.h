@@ -32,18 +32,19 @@ extern "C" {
  *      (outputs are filled with a marker NaN before each call); a NaN or Inf it writes
  *      gives FESD_ERR_NONFINITE. ---- */
 
-/** Mode field f_{sys,mode}(x,u): write nx values to f. */
-typedef int (*fesd_field_fn)(int sys, int mode, const double *x, const double *u, double *f,
+/** Mode field f_{sys,mode}(t,x,u): write nx values to f. t is the time of the point (see
+ *  fesd_model.time_dependent). */
+typedef int (*fesd_field_fn)(int sys, int mode, double t, const double *x, const double *u, double *f,
                              void *user);
 /** Jacobians of f_{sys,mode}: dfdx (nx x nx, column-major), dfdu (nx x nu, column-major;
  *  NULL when nu == 0). */
-typedef int (*fesd_field_jac_fn)(int sys, int mode, const double *x, const double *u,
+typedef int (*fesd_field_jac_fn)(int sys, int mode, double t, const double *x, const double *u,
                                  double *dfdx, double *dfdu, void *user);
 /** Switching functions c^sys(x,u) (n_switch[sys] values), or indicators g^sys
  *  (n_modes[sys] values) when n_switch[sys] == 0. */
-typedef int (*fesd_switch_fn)(int sys, const double *x, const double *u, double *c, void *user);
+typedef int (*fesd_switch_fn)(int sys, double t, const double *x, const double *u, double *c, void *user);
 /** Jacobians of the switch callback: dcdx (rows x nx), dcdu (rows x nu; NULL when nu == 0). */
-typedef int (*fesd_switch_jac_fn)(int sys, const double *x, const double *u, double *dcdx,
+typedef int (*fesd_switch_jac_fn)(int sys, double t, const double *x, const double *u, double *dcdx,
                                   double *dcdu, void *user);
 
 /**

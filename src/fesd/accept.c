@@ -19,7 +19,7 @@ int fesd__update_lambda00(fesd_integrator *it, const double *x, const double *u,
     pe.dgdx = it->pscr.dgdx;
     pe.dgdu = nu > 0 ? dgdu : NULL;
   }
-  int st = fesd__model_eval(m, x, u, &pe);
+  int st = fesd__model_eval(m, it->t, x, u, &pe);
   if (st) return st;
   for (int k = 0; k < m->nsys; k++) {
     int imin = m->th_off[k];
@@ -58,7 +58,7 @@ static int start_jump(fesd_integrator *it, const double *z, int k) {
   pe.g = it->pscr.g;
   pe.dgdx = it->pscr.dgdx;
   pe.dgdu = nu > 0 ? it->pscr.dgdu : NULL;
-  int st = fesd__model_eval(m, it->x, it->sys.u, &pe);
+  int st = fesd__model_eval(m, it->t, it->x, it->sys.u, &pe);
   if (st) return st;
   const double *th1 = z + fesd__th(&it->sys, 0, 0);
   double *df = it->vtmp, *fm = it->vtmp + nx; /* f+ - f-, f- */

@@ -41,7 +41,7 @@ static int resolve_ties(fesd_integrator *it, const double *u, unsigned char *a, 
   pe.F = it->pscr.F;
   pe.g = it->pscr.g;
   pe.dgdx = it->pscr.dgdx;
-  int st = fesd__model_eval(m, it->x, u, &pe);
+  int st = fesd__model_eval(m, it->t, it->x, u, &pe);
   if (st) return st;
   double *ftot = it->gbuf + nth, *f = it->vtmp; /* nx each */
   memset(ftot, 0, (size_t)nx * sizeof(double));
@@ -96,7 +96,7 @@ int fesd__act_start(fesd_integrator *it, const double *u, unsigned char *a, int 
     return FESD_OK;
   }
   fesd__model *m = &it->model;
-  int st = fesd__model_g(m, it->x, u, it->gbuf);
+  int st = fesd__model_g(m, it->t, it->x, u, it->gbuf);
   if (st) return st;
   int tied = 0;
   for (int k = 0; k < m->nsys; k++) {

@@ -19,6 +19,7 @@ int fesd__consistent_guess(fesd_integrator *it, double *z) {
   fesd__point_eval pe = {0}, pg = {0}; /* fields only in the sweeps; indicators once after */
   pe.F = it->pscr.F;
   pg.g = g;
+  double tn = S->t0;
   for (int n = 0; n < S->N; n++) {
     const double *xn = n == 0 ? S->x0 : z + S->xo[n - 1];
     double h = z[S->ho[n]];
@@ -40,7 +41,7 @@ int fesd__consistent_guess(fesd_integrator *it, double *z) {
           for (int l = 0; l < s; l++) acc += S->tab.A[j][l] * z[fesd__v(S, n, l) + r];
           X[r] = xn[r] + (frozen ? 0.0 : h * acc);
         }
-        int st = fesd__model_eval(m, X, S->u, &pe);
+        int st = fesd__model_eval(m, tn + S->tab.c[j] * h, X, S->u, &pe);
         if (st) return st;
         const double *th = z + fesd__th(S, n, j);
         double *v = z + fesd__v(S, n, j);
@@ -71,7 +72,7 @@ int fesd__consistent_guess(fesd_integrator *it, double *z) {
         for (int l = 0; l < s; l++) acc += S->tab.A[j][l] * z[fesd__v(S, n, l) + r];
         X[r] = xn[r] + h * acc;
       }
-      int st = fesd__model_eval(m, X, S->u, &pg);
+      int st = fesd__model_eval(m, tn + S->tab.c[j] * h, X, S->u, &pg);
       if (st) return st;
       const double *th = z + fesd__th(S, n, j);
       double *la = z + fesd__la(S, n, j), *mu = z + fesd__mu(S, n, j);
@@ -88,7 +89,7 @@ int fesd__consistent_guess(fesd_integrator *it, double *z) {
       z[S->xo[n] + r] = xn[r] + h * acc;
     }
     if (S->bp) {
-      int st = fesd__model_g(m, z + S->xo[n], S->u, g);
+      int st = fesd__model_g(m, tn + h, z + S->xo[n], S->u, g);
       if (st) return st;
       const double *th = z + fesd__th(S, n, s - 1);
       double *LB = z + S->lbo[n], *MB = LB + nth;
@@ -99,6 +100,7 @@ int fesd__consistent_guess(fesd_integrator *it, double *z) {
       }
       for (int i = 0; i < nth; i++) LB[i] = g[i] - MB[m->sys_of[i]];
     }
+    tn += h;
   }
   return FESD_OK;
 }
@@ -119,7 +121,7 @@ static int lp_block(fesd_integrator *it, const double *x, const double *u, doubl
   fesd__model *m = &it->model;
   const int nx = m->nx, nth = m->nth;
   double *th = block + nx, *la = th + nth, *mu = la + nth;
-  int st = fesd__model_g(m, x, u, it->gbuf);
+  int st = fesd__model_g(m, it->t, x, u, it->gbuf);
   if (st) return st;
   for (int k = 0; k < m->nsys; k++) {
     double gmin = INFINITY;
@@ -135,7 +137,7 @@ static int lp_block(fesd_integrator *it, const double *x, const double *u, doubl
   }
   fesd__point_eval pe = {0};
   pe.F = it->pscr.F;
-  if ((st = fesd__model_eval(m, x, u, &pe))) return st;
+  if ((st = fesd__model_eval(m, it->t, x, u, &pe))) return st;
   memset(block, 0, (size_t)nx * sizeof(double));
   for (int i = 0; i < nth; i++)
     if (th[i] != 0.0) fesd__F_axpy(m, &pe, i, th[i], block);
@@ -223,7 +225,7 @@ int fesd__regrid_guess(fesd_integrator *it, const double *zp, int Np, double *z)
     const double h = z[S->ho[n]];
     for (int j = 0; j < s; j++) {
       fesd__state_at(it, zp, Np, tn + S->tab.c[j] * h, X);
-      int st = fesd__model_eval(m, X, S->u, &pe);
+      int st = fesd__model_eval(m, S->t0 + tn + S->tab.c[j] * h, X, S->u, &pe);
       if (st) return st;
       double *v = z + fesd__v(S, n, j), *th = z + fesd__th(S, n, j);
       stage_theta(it, &pe, it->act + (size_t)(n * s + j) * nth, th);
@@ -235,7 +237,7 @@ int fesd__regrid_guess(fesd_integrator *it, const double *zp, int Np, double *z)
     tn += h;
     fesd__state_at(it, zp, Np, tn, z + S->xo[n]);
     if (S->bp) {
-      int st = fesd__model_g(m, z + S->xo[n], S->u, pe.g);
+      int st = fesd__model_g(m, S->t0 + tn, z + S->xo[n], S->u, pe.g);
       if (st) return st;
       double *LB = z + S->lbo[n];
       stage_lp(m, pe.g, z + fesd__th(S, n, s - 1), LB, LB + nth);

@@ -334,14 +334,14 @@ void fesd__point_free(fesd__point_eval *pe) {
 
 static int call_field(fesd__model *m, int k, int i, const double *x, const double *u, double *f) {
   mark_unwritten(f, m->nr[k]);
-  int st = m->user.field(k, i, x, u, f, m->user.user) ? FESD_ERR_CALLBACK : check_outputs(f, m->nr[k]);
+  int st = m->user.field(k, i, m->t, x, u, f, m->user.user) ? FESD_ERR_CALLBACK : check_outputs(f, m->nr[k]);
   if (st) m->failed = "field";
   return st;
 }
 
 static int call_switch(fesd__model *m, int k, const double *x, const double *u, double *c) {
   mark_unwritten(c, m->swr[k]);
-  int st = m->user.sw(k, x, u, c, m->user.user) ? FESD_ERR_CALLBACK : check_outputs(c, m->swr[k]);
+  int st = m->user.sw(k, m->t, x, u, c, m->user.user) ? FESD_ERR_CALLBACK : check_outputs(c, m->swr[k]);
   if (st) m->failed = "switch";
   return st;
 }
@@ -364,7 +364,8 @@ static void indicators_from(const fesd__model *m, int k, const double *c, double
 /* Central difference step: cbrt(eps) scaled (error ~ eps^(2/3)). */
 static double fd_step(double v) { return 6.055454452393343e-06 * fmax(1.0, fabs(v)); }
 
-int fesd__model_g(fesd__model *m, const double *x, const double *u, double *g) {
+int fesd__model_g(fesd__model *m, double t, const double *x, const double *u, double *g) {
+  m->t = t;
   for (int k = 0; k < m->nsys; k++) {
     int st = call_switch(m, k, x, u, m->cbuf);
     if (st) return st;
@@ -381,7 +382,7 @@ static int switch_derivatives(fesd__model *m, int k, const double *x, const doub
     const int nu_out = want_u ? rows * nu : 0;
     mark_unwritten(m->dcbuf, m->sj_nnz[k]);
     mark_unwritten(m->dcubuf, nu_out);
-    st = m->user.sw_jac(k, x, u, m->dcbuf, want_u ? m->dcubuf : NULL, m->user.user) ? FESD_ERR_CALLBACK : 0;
+    st = m->user.sw_jac(k, m->t, x, u, m->dcbuf, want_u ? m->dcubuf : NULL, m->user.user) ? FESD_ERR_CALLBACK : 0;
     if (!st) st = check_outputs(m->dcbuf, m->sj_nnz[k]);
     if (!st) st = check_outputs(m->dcubuf, nu_out);
     if (st) m->failed = "switch_jac";
@@ -453,7 +454,7 @@ static int eval_field_jac(fesd__model *m, int k, int i, int col, const double *x
     const int nx_out = dfdx ? m->fj_nnz[k] : 0, nu_out = dfdu ? m->nr[k] * nu : 0;
     mark_unwritten(dfdx, nx_out);
     mark_unwritten(dfdu, nu_out);
-    st = m->user.field_jac(k, i, x, u, dfdx ? dfdx : m->jxbuf, dfdu, m->user.user) ? FESD_ERR_CALLBACK : 0;
+    st = m->user.field_jac(k, i, m->t, x, u, dfdx ? dfdx : m->jxbuf, dfdu, m->user.user) ? FESD_ERR_CALLBACK : 0;
     if (!st) st = check_outputs(dfdx, nx_out);
     if (!st) st = check_outputs(dfdu, nu_out);
     if (st) m->failed = "field_jac";
@@ -487,7 +488,8 @@ static int eval_field_jac(fesd__model *m, int k, int i, int col, const double *x
   return FESD_OK;
 }
 
-int fesd__model_eval(fesd__model *m, const double *x, const double *u, fesd__point_eval *o) {
+int fesd__model_eval(fesd__model *m, double t, const double *x, const double *u, fesd__point_eval *o) {
+  m->t = t;
   int st;
   for (int k = 0; k < m->nsys; k++) {
     for (int i = 0; i < m->nf[k]; i++) {

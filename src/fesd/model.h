@@ -31,6 +31,7 @@ typedef struct {
   int max_sw, max_fj, max_nr;
   double *xp, *cbuf, *cbuf2, *dcbuf, *dcubuf, *fbuf, *fbuf2, *up, *jxbuf;
   const char *failed;    /* name of the callback that failed last */
+  double t;              /* time of the point being evaluated (passed to the callbacks) */
 } fesd__model;
 
 /* Output of one evaluation; NULL members are not computed. */
@@ -48,11 +49,11 @@ void fesd__model_free(fesd__model *m);
 /* Allocate / free the arrays of a point evaluation for this model. */
 int fesd__point_alloc(const fesd__model *m, fesd__point_eval *pe, int fields);
 void fesd__point_free(fesd__point_eval *pe);
-/* Evaluate at x (u may be NULL when nu == 0). Returns FESD_OK, FESD_ERR_CALLBACK or
+/* Evaluate at (t, x) (u may be NULL when nu == 0). Returns FESD_OK, FESD_ERR_CALLBACK or
  * FESD_ERR_NONFINITE (m->failed names the callback). */
-int fesd__model_eval(fesd__model *m, const double *x, const double *u, fesd__point_eval *out);
-/* Only g at x. */
-int fesd__model_g(fesd__model *m, const double *x, const double *u, double *g);
+int fesd__model_eval(fesd__model *m, double t, const double *x, const double *u, fesd__point_eval *out);
+/* Only g at (t, x). */
+int fesd__model_g(fesd__model *m, double t, const double *x, const double *u, double *g);
 
 /* y += a f_i (y dense, nx) */
 void fesd__F_axpy(const fesd__model *m, const fesd__point_eval *pe, int i, double a, double *y);

@@ -199,7 +199,7 @@ static int enter_set(fesd_integrator *it, const double *z, double t, int k, cons
     pe.F = it->pscr.F;
     pe.g = it->pscr.g;
     pe.dgdx = it->pscr.dgdx;
-    int st = fesd__model_eval(&it->model, x, S->u, &pe);
+    int st = fesd__model_eval(&it->model, S->t0 + t, x, S->u, &pe);
     if (st) return st;
     /* thetas of the other subsystems: the stage nearest before t */
     double tn = 0;

@@ -248,7 +248,7 @@ static int start_solve(fesd_integrator *it, fesd_step_info *info) {
  * first: an exit drops the mode; an entering mode j replaces the set (crossing) or joins it
  * (sliding), in the order given by the direction of the fields at the stage state. */
 static int candidates(fesd_integrator *it, const fesd__violation *v, const unsigned char *cur,
-                      const double *x, const double *theta, unsigned char cands[2][64]) {
+                      double t, const double *x, const double *theta, unsigned char cands[2][64]) {
   const fesd__model *m = &it->model;
   const int k0 = m->th_off[v->sys], k1 = m->th_off[v->sys + 1];
   if (k1 - k0 > 64) return 0;
@@ -264,7 +264,7 @@ static int candidates(fesd_integrator *it, const fesd__violation *v, const unsig
   pe.F = it->pscr.F;
   pe.g = it->pscr.g;
   pe.dgdx = it->pscr.dgdx;
-  if (fesd__model_eval(&it->model, x, it->sys.u, &pe)) return 0;
+  if (fesd__model_eval(&it->model, t, x, it->sys.u, &pe)) return 0;
   double ai, aj;
   fesd__total_field(it, &pe, theta, it->ftot);
   fesd__normal_components(it, &pe, theta, it->ftot, i_old, v->mode, &ai, &aj);
@@ -289,7 +289,10 @@ static int std_switch(fesd_integrator *it, fesd__violation v, fesd_step_info *in
     if (p0 >= ns) return FESD_ERR_STEP_FAILED;
     unsigned char cands[2][64];
     const double *x = S->X + (size_t)p0 * S->nx; /* the stage state of the last solve */
-    int nc = candidates(it, &v, it->act + (size_t)p0 * nth, x, z + fesd__th(S, p0 / S->s, p0 % S->s), cands);
+    double tp = S->t0; /* the time of stage p0 */
+    for (int n = 0; n < p0 / S->s; n++) tp += z[S->ho[n]];
+    tp += S->tab.c[p0 % S->s] * z[S->ho[p0 / S->s]];
+    int nc = candidates(it, &v, it->act + (size_t)p0 * nth, tp, x, z + fesd__th(S, p0 / S->s, p0 % S->s), cands);
     if (nc == 0) return FESD_ERR_STEP_FAILED;
     memcpy(it->zpred, z, (size_t)S->n * sizeof(double));
     int advanced = 0;
@@ -344,7 +347,7 @@ static int explicit_std(fesd_integrator *it) {
         for (int l = 0; l < j; l++) acc += S->tab.A[j][l] * z[fesd__v(S, n, l) + r];
         X[r] = xn[r] + h * acc;
       }
-      int st = fesd__model_eval(m, X, S->u, &pe);
+      int st = fesd__model_eval(m, S->t0 + (n + S->tab.c[j]) * h, X, S->u, &pe);
       if (st) return st;
       unsigned char *a = it->act + (size_t)(n * s + j) * nth;
       double *th = z + fesd__th(S, n, j), *la = z + fesd__la(S, n, j), *mu = z + fesd__mu(S, n, j);
@@ -368,7 +371,7 @@ static int explicit_std(fesd_integrator *it) {
       z[S->xo[n] + r] = xn[r] + h * acc;
     }
     if (S->bp) {
-      int st = fesd__model_g(m, z + S->xo[n], S->u, g);
+      int st = fesd__model_g(m, S->t0 + (n + 1) * h, z + S->xo[n], S->u, g);
       if (st) return st;
       const double *th = z + fesd__th(S, n, s - 1);
       double *LB = z + S->lbo[n], *MB = LB + nth;
@@ -466,6 +469,7 @@ static int try_step(fesd_integrator *it, const double *u, double *T, fesd_step_i
   fesd__system *S = &it->sys;
   const double T_full = *T;
   S->x0 = it->x;
+  S->t0 = it->t;
   S->u = u;
   S->lam00 = it->lam00;
   S->T = *T;

@@ -323,6 +323,7 @@ int fesd__system_points(fesd__system *S, const double *z, int want_jac) {
   const int N = S->N, s = S->s, nx = S->nx, nth = S->nth, nu = S->nu;
   fesd__model *m = S->model;
   double *K = S->tmp; /* K_j = sum_l a_jl v_l */
+  double tn = S->t0;
   for (int n = 0; n < N; n++) {
     const double *xn = elem_start(S, z, n);
     const double h = z[S->ho[n]];
@@ -338,7 +339,7 @@ int fesd__system_points(fesd__system *S, const double *z, int want_jac) {
       fesd__point_eval pe = S->pe[p];
       if (!want_jac) pe.dFdx = pe.dgdx = NULL;
       if (!(want_jac && S->want_u)) pe.dFdu = pe.dgdu = NULL;
-      int st = fesd__model_eval(m, X, S->u, &pe);
+      int st = fesd__model_eval(m, tn + S->tab.c[j] * h, X, S->u, &pe);
       if (st) return st;
       if (want_jac) {
         const double *th = z + fesd__th(S, n, j);
@@ -364,9 +365,10 @@ int fesd__system_points(fesd__system *S, const double *z, int want_jac) {
       pb.F = pb.dFdx = pb.dFdu = NULL;
       if (!want_jac) pb.dgdx = NULL;
       if (!(want_jac && S->want_u)) pb.dgdu = NULL;
-      int st = fesd__model_eval(m, z + S->xo[n], S->u, &pb);
+      int st = fesd__model_eval(m, tn + h, z + S->xo[n], S->u, &pb);
       if (st) return st;
     }
+    tn += h;
   }
   return FESD_OK;
 }

@@ -47,7 +47,7 @@ typedef struct {
   int nnz; /* Jacobian entries of the current layout */
   /* parameters of the current step */
   const double *x0, *u, *lam00;
-  double T;
+  double T, t0; /* step length; time of the step start (the callbacks get t0 + the point's time) */
   int want_u; /* evaluate u-derivatives (sensitivities) */
   /* scratch: evaluations at N*s stage points and N boundary points */
   fesd__point_eval *pe;

@@ -260,7 +260,7 @@ static int scan_filippov(fesd_integrator *it, const double *z, const unsigned ch
           for (int l = 0; l < s; l++) acc += S->tab.A[q][l] * z[fesd__v(S, n, l) + r];
           X[r] = xn[r] + h * acc;
         }
-        int st = fesd__model_eval(m, X, S->u, &pe);
+        int st = fesd__model_eval(m, S->t0 + tn + S->tab.c[q] * h, X, S->u, &pe);
         if (st) return st;
         const double *th = z + fesd__th(S, n, q);
         fesd__total_field(it, &pe, th, it->ftot);
@@ -307,9 +307,9 @@ static int scan_interior(fesd_integrator *it, const double *z, const unsigned ch
       fesd__poly_state(it, z, n, it->mid_w + p * FESD_RK_MAX_STAGES, x);
       fesd__point_eval q = pe;
       if (!sliding) q.F = q.dgdx = NULL;
-      int st = fesd__model_eval(m, x, S->u, &q);
-      if (st) return st;
       const double t = tn + it->mid_tau[p] * h;
+      int st = fesd__model_eval(m, S->t0 + t, x, S->u, &q);
+      if (st) return st;
       /* nearest stage for the thetas */
       int jn = 0;
       for (int j = 1; j < s; j++)

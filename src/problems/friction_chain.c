@@ -6,7 +6,7 @@
 
 /* Subsystem 0 carries the smooth spring dynamics and the friction of mass 0 (all rows);
  * subsystem i >= 1 only the friction of mass i (row n + i). Mode 0: v_i > vb. */
-static int fc_field(int sys, int mode, const double *x, const double *u, double *f, void *user) {
+static int fc_field(int sys, int mode, double t, const double *x, const double *u, double *f, void *user) {
   (void)u;
   const fesd_friction_chain *fc = user;
   const int n = fc->n;
@@ -23,7 +23,7 @@ static int fc_field(int sys, int mode, const double *x, const double *u, double 
   return 0;
 }
 
-static int fc_field_jac(int sys, int mode, const double *x, const double *u, double *J, double *Ju,
+static int fc_field_jac(int sys, int mode, double t, const double *x, const double *u, double *J, double *Ju,
                         void *user) {
   (void)mode, (void)x, (void)u, (void)Ju;
   const fesd_friction_chain *fc = user;
@@ -39,14 +39,14 @@ static int fc_field_jac(int sys, int mode, const double *x, const double *u, dou
   return 0;
 }
 
-static int fc_sw(int sys, const double *x, const double *u, double *c, void *user) {
+static int fc_sw(int sys, double t, const double *x, const double *u, double *c, void *user) {
   (void)u;
   const fesd_friction_chain *fc = user;
   c[0] = x[fc->n + sys] - fc->vb;
   return 0;
 }
 
-static int fc_sw_jac(int sys, const double *x, const double *u, double *J, double *Ju, void *user) {
+static int fc_sw_jac(int sys, double t, const double *x, const double *u, double *J, double *Ju, void *user) {
   (void)sys, (void)x, (void)u, (void)Ju, (void)user;
   J[0] = 1.0;
   return 0;

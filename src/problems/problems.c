@@ -9,14 +9,14 @@ static const int one_switch[1] = {1};
 static const double W = 2.0 * PI;
 
 /* ---- oscillator (paper Sec. 4.4): mode 0 = c > 0 (outside): A1 x, mode 1 = c < 0: A2 x ---- */
-static int osc_field(int sys, int mode, const double *x, const double *u, double *f, void *user) {
+static int osc_field(int sys, int mode, double t, const double *x, const double *u, double *f, void *user) {
   (void)sys, (void)u, (void)user;
   double s = mode == 0 ? 1.0 : -1.0; /* A1 = [[1, w], [-w, 1]], A2 = [[1, -w], [w, 1]] */
   f[0] = x[0] + s * W * x[1];
   f[1] = -s * W * x[0] + x[1];
   return 0;
 }
-static int osc_field_jac(int sys, int mode, const double *x, const double *u, double *J, double *Ju,
+static int osc_field_jac(int sys, int mode, double t, const double *x, const double *u, double *J, double *Ju,
                          void *user) {
   (void)sys, (void)x, (void)u, (void)Ju, (void)user;
   double s = mode == 0 ? 1.0 : -1.0;
@@ -26,12 +26,12 @@ static int osc_field_jac(int sys, int mode, const double *x, const double *u, do
   J[3] = 1;
   return 0;
 }
-static int osc_sw(int sys, const double *x, const double *u, double *c, void *user) {
+static int osc_sw(int sys, double t, const double *x, const double *u, double *c, void *user) {
   (void)sys, (void)u, (void)user;
   c[0] = x[0] * x[0] + x[1] * x[1] - 1.0;
   return 0;
 }
-static int osc_sw_jac(int sys, const double *x, const double *u, double *J, double *Ju, void *user) {
+static int osc_sw_jac(int sys, double t, const double *x, const double *u, double *J, double *Ju, void *user) {
   (void)sys, (void)u, (void)Ju, (void)user;
   J[0] = 2 * x[0];
   J[1] = 2 * x[1];
@@ -60,14 +60,14 @@ static const scalar_law law_c = {-1, 1, 1, 0}; /* -sign(x) + t */
 static const scalar_law law_d = {1, -1, 0, 0}; /* sign(x) */
 static const scalar_law law_nl = {1, 3, 0, 1}; /* 2 - sign(x) + x^2 */
 
-static int scalar_field(int sys, int mode, const double *x, const double *u, double *f, void *user) {
+static int scalar_field(int sys, int mode, double t, const double *x, const double *u, double *f, void *user) {
   (void)sys, (void)u;
   const scalar_law *L = user;
   f[0] = (mode == 0 ? L->f_pos : L->f_neg) + L->t_coef * x[1] + L->x2_coef * x[0] * x[0];
   f[1] = 1.0;
   return 0;
 }
-static int scalar_field_jac(int sys, int mode, const double *x, const double *u, double *J,
+static int scalar_field_jac(int sys, int mode, double t, const double *x, const double *u, double *J,
                             double *Ju, void *user) {
   (void)sys, (void)mode, (void)u, (void)Ju;
   const scalar_law *L = user;
@@ -77,12 +77,12 @@ static int scalar_field_jac(int sys, int mode, const double *x, const double *u,
   J[3] = 0;
   return 0;
 }
-static int scalar_sw(int sys, const double *x, const double *u, double *c, void *user) {
+static int scalar_sw(int sys, double t, const double *x, const double *u, double *c, void *user) {
   (void)sys, (void)u, (void)user;
   c[0] = x[0];
   return 0;
 }
-static int scalar_sw_jac(int sys, const double *x, const double *u, double *J, double *Ju, void *user) {
+static int scalar_sw_jac(int sys, double t, const double *x, const double *u, double *J, double *Ju, void *user) {
   (void)sys, (void)x, (void)u, (void)Ju, (void)user;
   J[0] = 1;
   J[1] = 0;
@@ -105,13 +105,13 @@ static int exact_c(double t, double *x) {
 }
 
 /* ---- stewart-anitescu: x' in 2 - sign(x) with the running cost q' = x^2 ---- */
-static int sa_field(int sys, int mode, const double *x, const double *u, double *f, void *user) {
+static int sa_field(int sys, int mode, double t, const double *x, const double *u, double *f, void *user) {
   (void)sys, (void)u, (void)user;
   f[0] = mode == 0 ? 1.0 : 3.0;
   f[1] = x[0] * x[0];
   return 0;
 }
-static int sa_field_jac(int sys, int mode, const double *x, const double *u, double *J, double *Ju,
+static int sa_field_jac(int sys, int mode, double t, const double *x, const double *u, double *J, double *Ju,
                         void *user) {
   (void)sys, (void)mode, (void)u, (void)Ju, (void)user;
   J[0] = 0;
@@ -124,13 +124,13 @@ static int sa_field_jac(int sys, int mode, const double *x, const double *u, dou
 /* ---- slide-exit-2d (notes/sliding_exit.md): sliding on the curved surface
  * c = x1 + x2^2/2 from x0 = 0, leaving it when the sliding multiplier of the c < 0 mode
  * reaches 0. mode 0 (c > 0): f = (-1 + x2, (1 + x2^2)/2); mode 1: f = (1 + x2, (1 + x2^2)/2 + x2/2) */
-static int se_field(int sys, int mode, const double *x, const double *u, double *f, void *user) {
+static int se_field(int sys, int mode, double t, const double *x, const double *u, double *f, void *user) {
   (void)sys, (void)u, (void)user;
   f[0] = (mode == 0 ? -1.0 : 1.0) + x[1];
   f[1] = 0.5 * (1 + x[1] * x[1]) + (mode == 0 ? 0.0 : 0.5 * x[1]);
   return 0;
 }
-static int se_field_jac(int sys, int mode, const double *x, const double *u, double *J, double *Ju,
+static int se_field_jac(int sys, int mode, double t, const double *x, const double *u, double *J, double *Ju,
                         void *user) {
   (void)sys, (void)u, (void)Ju, (void)user;
   J[0] = 0;
@@ -139,12 +139,12 @@ static int se_field_jac(int sys, int mode, const double *x, const double *u, dou
   J[3] = x[1] + (mode == 0 ? 0.0 : 0.5);
   return 0;
 }
-static int se_sw(int sys, const double *x, const double *u, double *c, void *user) {
+static int se_sw(int sys, double t, const double *x, const double *u, double *c, void *user) {
   (void)sys, (void)u, (void)user;
   c[0] = x[0] + 0.5 * x[1] * x[1];
   return 0;
 }
-static int se_sw_jac(int sys, const double *x, const double *u, double *J, double *Ju, void *user) {
+static int se_sw_jac(int sys, double t, const double *x, const double *u, double *J, double *Ju, void *user) {
   (void)sys, (void)u, (void)Ju, (void)user;
   J[0] = 1;
   J[1] = x[1];
@@ -182,7 +182,7 @@ static int se_exact(double t, double *x) {
 /* ---- ocp-dynamics (paper Sec. 5): q' = -sign(c(q)) + v, v' = u, two subsystems ---- */
 static const int two_sys_modes[2] = {2, 2};
 static const int two_sys_switch[2] = {1, 1};
-static int ocp_field(int sys, int mode, const double *x, const double *u, double *f, void *user) {
+static int ocp_field(int sys, int mode, double t, const double *x, const double *u, double *f, void *user) {
   (void)user;
   double sg = mode == 0 ? -1.0 : 1.0; /* mode 0: c_k > 0 -> -sign = -1 */
   if (sys == 0) {
@@ -198,7 +198,7 @@ static int ocp_field(int sys, int mode, const double *x, const double *u, double
   }
   return 0;
 }
-static int ocp_field_jac(int sys, int mode, const double *x, const double *u, double *J, double *Ju,
+static int ocp_field_jac(int sys, int mode, double t, const double *x, const double *u, double *J, double *Ju,
                          void *user) {
   (void)mode, (void)x, (void)u, (void)user;
   memset(J, 0, 16 * sizeof(double));
@@ -213,12 +213,12 @@ static int ocp_field_jac(int sys, int mode, const double *x, const double *u, do
   }
   return 0;
 }
-static int ocp_sw(int sys, const double *x, const double *u, double *c, void *user) {
+static int ocp_sw(int sys, double t, const double *x, const double *u, double *c, void *user) {
   (void)u, (void)user;
   c[0] = sys == 0 ? x[0] + 0.15 * x[1] * x[1] : -0.05 * x[0] * x[0] * x[0] + x[1];
   return 0;
 }
-static int ocp_sw_jac(int sys, const double *x, const double *u, double *J, double *Ju, void *user) {
+static int ocp_sw_jac(int sys, double t, const double *x, const double *u, double *J, double *Ju, void *user) {
   (void)u, (void)user;
   if (sys == 0) {
     J[0] = 1;

@@ -37,14 +37,14 @@ static int fails = 0;
 
 /* ---- three subsystems, default sign matrices: x0 crosses 0, x1 crosses 0, x0 crosses 0.5
  *      and x0 + x1 crosses 0.2 (every field pushes both states up) ---- */
-static int m3_field(int sys, int mode, const double *x, const double *u, double *f, void *user) {
+static int m3_field(int sys, int mode, double t, const double *x, const double *u, double *f, void *user) {
   (void)x, (void)u, (void)user;
   if (sys == 0) f[0] = mode == 0 ? 1.0 : 2.0, f[1] = 0.0;
   else if (sys == 1) f[0] = 0.0, f[1] = 0.5 + 0.25 * mode;
   else f[0] = mode == 0 ? 0.1 : 0.2, f[1] = mode == 0 ? 0.1 : 0.3;
   return 0;
 }
-static int m3_sw(int sys, const double *x, const double *u, double *c, void *user) {
+static int m3_sw(int sys, double t, const double *x, const double *u, double *c, void *user) {
   (void)u, (void)user;
   if (sys == 0) c[0] = x[0];
   else if (sys == 1) c[0] = x[1], c[1] = x[0] - 0.5;
@@ -56,12 +56,12 @@ static const double m3_x0[2] = {-0.5, -0.3};
 
 /* ---- a user sign matrix: 3 modes of 2 switching functions c = (x, x + 1); x' = 3, 2, 1
  *      in x < -1, -1 < x < 0, x > 0 ---- */
-static int us_field(int sys, int mode, const double *x, const double *u, double *f, void *user) {
+static int us_field(int sys, int mode, double t, const double *x, const double *u, double *f, void *user) {
   (void)sys, (void)x, (void)u, (void)user;
   f[0] = 1.0 + mode;
   return 0;
 }
-static int us_sw(int sys, const double *x, const double *u, double *c, void *user) {
+static int us_sw(int sys, double t, const double *x, const double *u, double *c, void *user) {
   (void)sys, (void)u, (void)user;
   c[0] = x[0];
   c[1] = x[0] + 1.0;

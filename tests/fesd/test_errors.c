@@ -39,25 +39,25 @@ static int fault(injector *in, int cb, double *out, int n) {
 }
 
 static const double W = 2 * 3.14159265358979323846;
-static int osc_field(int sys, int mode, const double *x, const double *u, double *f, void *user) {
+static int osc_field(int sys, int mode, double t, const double *x, const double *u, double *f, void *user) {
   (void)sys, (void)u;
   double s = mode == 0 ? 1.0 : -1.0;
   f[0] = x[0] + s * W * x[1];
   f[1] = -s * W * x[0] + x[1];
   return fault(user, CB_FIELD, f, 2);
 }
-static int osc_field_jac(int sys, int mode, const double *x, const double *u, double *J, double *Ju, void *user) {
+static int osc_field_jac(int sys, int mode, double t, const double *x, const double *u, double *J, double *Ju, void *user) {
   (void)sys, (void)x, (void)u, (void)Ju;
   double s = mode == 0 ? 1.0 : -1.0;
   J[0] = 1, J[1] = -s * W, J[2] = s * W, J[3] = 1;
   return fault(user, CB_FIELD_JAC, J, 4);
 }
-static int osc_sw(int sys, const double *x, const double *u, double *c, void *user) {
+static int osc_sw(int sys, double t, const double *x, const double *u, double *c, void *user) {
   (void)sys, (void)u;
   c[0] = x[0] * x[0] + x[1] * x[1] - 1.0;
   return fault(user, CB_SWITCH, c, 1);
 }
-static int osc_sw_jac(int sys, const double *x, const double *u, double *J, double *Ju, void *user) {
+static int osc_sw_jac(int sys, double t, const double *x, const double *u, double *J, double *Ju, void *user) {
   (void)sys, (void)u, (void)Ju;
   J[0] = 2 * x[0], J[1] = 2 * x[1];
   return fault(user, CB_SWITCH_JAC, J, 2);
@@ -288,12 +288,12 @@ static void bad_models(void) {
   printf("models: %d invalid models rejected\n", n - 1);
 }
 
-static int u_field(int sys, int mode, const double *x, const double *u, double *f, void *user) {
+static int u_field(int sys, int mode, double t, const double *x, const double *u, double *f, void *user) {
   (void)sys, (void)x, (void)user;
   f[0] = u[0] + (mode == 0 ? -1.0 : 1.0);
   return 0;
 }
-static int u_sw(int sys, const double *x, const double *u, double *c, void *user) {
+static int u_sw(int sys, double t, const double *x, const double *u, double *c, void *user) {
   (void)sys, (void)u, (void)user;
   c[0] = x[0];
   return 0;
@@ -500,12 +500,12 @@ static void faults(void) {
  *      Newton fails on the full step near the blow-up; the step is halved, which must give
  *      exactly the result of two steps of 0.45, and the split is counted in the statistics.
  *      With max_splits = 0: FESD_ERR_STEP_FAILED, failed_time 0 and the state unchanged. ---- */
-static int sq_field(int sys, int mode, const double *x, const double *u, double *f, void *user) {
+static int sq_field(int sys, int mode, double t, const double *x, const double *u, double *f, void *user) {
   (void)sys, (void)mode, (void)u, (void)user;
   f[0] = x[0] * x[0];
   return 0;
 }
-static int sq_sw(int sys, const double *x, const double *u, double *c, void *user) {
+static int sq_sw(int sys, double t, const double *x, const double *u, double *c, void *user) {
   (void)sys, (void)u, (void)user;
   c[0] = x[0] - 1e6;
   return 0;

@@ -30,23 +30,23 @@ typedef struct {
   double center[MAXM], v[MAXM]; /* per mode */
 } chain;
 
-static int field(int sys, int mode, const double *x, const double *u, double *f, void *user) {
+static int field(int sys, int mode, double t, const double *x, const double *u, double *f, void *user) {
   (void)sys, (void)x, (void)u;
   f[0] = ((const chain *)user)->v[mode];
   return 0;
 }
-static int field_jac(int sys, int mode, const double *x, const double *u, double *J, double *Ju, void *user) {
+static int field_jac(int sys, int mode, double t, const double *x, const double *u, double *J, double *Ju, void *user) {
   (void)sys, (void)mode, (void)x, (void)u, (void)Ju, (void)user;
   J[0] = 0.0;
   return 0;
 }
-static int ind(int sys, const double *x, const double *u, double *g, void *user) {
+static int ind(int sys, double t, const double *x, const double *u, double *g, void *user) {
   (void)sys, (void)u;
   const chain *c = user;
   for (int i = 0; i < c->M; i++) g[i] = (x[0] - c->center[i]) * (x[0] - c->center[i]);
   return 0;
 }
-static int ind_jac(int sys, const double *x, const double *u, double *J, double *Ju, void *user) {
+static int ind_jac(int sys, double t, const double *x, const double *u, double *J, double *Ju, void *user) {
   (void)sys, (void)u, (void)Ju;
   const chain *c = user;
   for (int i = 0; i < c->M; i++) J[i] = 2.0 * (x[0] - c->center[i]);

@@ -15,31 +15,31 @@ typedef struct {
   double buf[4096];
 } dense_adapter;
 
-static int d_field(int k, int i, const double *x, const double *u, double *f, void *user) {
+static int d_field(int k, int i, double t, const double *x, const double *u, double *f, void *user) {
   dense_adapter *a = user;
   const fesd_sparsity *sp = &a->fc->sp[k];
-  int st = a->fc->model.field(k, i, x, u, a->buf, a->fc);
+  int st = a->fc->model.field(k, i, t, x, u, a->buf, a->fc);
   memset(f, 0, (size_t)a->fc->model.nx * sizeof(double));
   for (int r = 0; r < sp->n_rows; r++) f[sp->rows[r]] = a->buf[r];
   return st;
 }
-static int d_field_jac(int k, int i, const double *x, const double *u, double *J, double *Ju, void *user) {
+static int d_field_jac(int k, int i, double t, const double *x, const double *u, double *J, double *Ju, void *user) {
   dense_adapter *a = user;
   const fesd_sparsity *sp = &a->fc->sp[k];
   const int nx = a->fc->model.nx;
-  int st = a->fc->model.field_jac(k, i, x, u, a->buf, Ju, a->fc);
+  int st = a->fc->model.field_jac(k, i, t, x, u, a->buf, Ju, a->fc);
   memset(J, 0, (size_t)nx * nx * sizeof(double));
   for (int e = 0; e < sp->jac_nnz; e++) J[sp->jac_col[e] * nx + sp->rows[sp->jac_row[e]]] += a->buf[e];
   return st;
 }
-static int d_sw(int k, const double *x, const double *u, double *c, void *user) {
+static int d_sw(int k, double t, const double *x, const double *u, double *c, void *user) {
   dense_adapter *a = user;
-  return a->fc->model.sw(k, x, u, c, a->fc);
+  return a->fc->model.sw(k, t, x, u, c, a->fc);
 }
-static int d_sw_jac(int k, const double *x, const double *u, double *J, double *Ju, void *user) {
+static int d_sw_jac(int k, double t, const double *x, const double *u, double *J, double *Ju, void *user) {
   dense_adapter *a = user;
   const fesd_sparsity *sp = &a->fc->sp[k];
-  int st = a->fc->model.sw_jac(k, x, u, a->buf, Ju, a->fc);
+  int st = a->fc->model.sw_jac(k, t, x, u, a->buf, Ju, a->fc);
   memset(J, 0, (size_t)a->fc->model.nx * sizeof(double)); /* one switching function */
   for (int e = 0; e < sp->sw_nnz; e++) J[sp->sw_col[e]] += a->buf[e];
   return st;

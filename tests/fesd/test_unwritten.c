@@ -40,7 +40,7 @@ static void fault(const ctx *c, int out, double *v, int n, double on_entry) {
   v[n - 1] = c->write_nan ? NAN : on_entry;
 }
 
-static int field(int sys, int mode, const double *x, const double *u, double *f, void *user) {
+static int field(int sys, int mode, double t, const double *x, const double *u, double *f, void *user) {
   (void)sys;
   const ctx *c = user;
   const double keep = f[1];
@@ -49,7 +49,7 @@ static int field(int sys, int mode, const double *x, const double *u, double *f,
   fault(c, OUT_F, f, 2, keep);
   return 0;
 }
-static int field_jac(int sys, int mode, const double *x, const double *u, double *J, double *Ju, void *user) {
+static int field_jac(int sys, int mode, double t, const double *x, const double *u, double *J, double *Ju, void *user) {
   (void)sys, (void)mode, (void)x, (void)u;
   const ctx *c = user;
   const int nj = c->sparse ? 1 : 4;
@@ -65,7 +65,7 @@ static int field_jac(int sys, int mode, const double *x, const double *u, double
   fault(c, OUT_DFDU, Ju, 2, keep_u);
   return 0;
 }
-static int sw(int sys, const double *x, const double *u, double *g, void *user) {
+static int sw(int sys, double t, const double *x, const double *u, double *g, void *user) {
   (void)sys, (void)u;
   const ctx *c = user;
   const int n = c->indicators ? 2 : 1;
@@ -75,7 +75,7 @@ static int sw(int sys, const double *x, const double *u, double *g, void *user) 
   fault(c, OUT_C, g, n, keep);
   return 0;
 }
-static int sw_jac(int sys, const double *x, const double *u, double *J, double *Ju, void *user) {
+static int sw_jac(int sys, double t, const double *x, const double *u, double *J, double *Ju, void *user) {
   (void)sys, (void)x, (void)u;
   const ctx *c = user;
   const int rows = c->indicators ? 2 : 1, nx = c->sparse ? 3 : 2, nj = c->sparse ? rows : rows * nx;

@@ -24,7 +24,7 @@ static double spring(int k, const double *x) {
 }
 
 /* ---- FESD model ---- */
-static int field(int sys, int mode, const double *x, const double *u, double *f, void *user) {
+static int field(int sys, int mode, double t, const double *x, const double *u, double *f, void *user) {
   (void)u, (void)user;
   memset(f, 0, 2 * NB * sizeof(double));
   if (sys == 0)
@@ -35,7 +35,7 @@ static int field(int sys, int mode, const double *x, const double *u, double *f,
   f[NB + sys] += mode == 0 ? -FR[sys] : FR[sys]; /* mode 0: v > vb */
   return 0;
 }
-static int sw(int sys, const double *x, const double *u, double *c, void *user) {
+static int sw(int sys, double t, const double *x, const double *u, double *c, void *user) {
   (void)u, (void)user;
   c[0] = x[NB + sys] - VB;
   return 0;

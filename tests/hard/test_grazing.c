@@ -13,13 +13,13 @@
  * midpoint falls inside), with an error of at most d. */
 #include "hard_util.h"
 
-static int field(int sys, int mode, const double *x, const double *u, double *f, void *user) {
+static int field(int sys, int mode, double t, const double *x, const double *u, double *f, void *user) {
   (void)sys, (void)u, (void)user;
   f[0] = x[1] - (mode == 0 ? 1.0 : 0.0);
   f[1] = -1;
   return 0;
 }
-static int sw(int sys, const double *x, const double *u, double *c, void *user) {
+static int sw(int sys, double t, const double *x, const double *u, double *c, void *user) {
   (void)sys, (void)u, (void)user;
   c[0] = x[0];
   return 0;

@@ -9,12 +9,12 @@
 
 static const double B[4] = {0.0, -0.1, -0.3, -0.6};
 
-static int field(int sys, int mode, const double *x, const double *u, double *f, void *user) {
+static int field(int sys, int mode, double t, const double *x, const double *u, double *f, void *user) {
   (void)sys, (void)x, (void)u, (void)user;
   f[0] = mode + 1.0;
   return 0;
 }
-static int ind(int sys, const double *x, const double *u, double *g, void *user) {
+static int ind(int sys, double t, const double *x, const double *u, double *g, void *user) {
   (void)sys, (void)u, (void)user;
   for (int i = 0; i < 4; i++) g[i] = -(i * x[0] + B[i]);
   return 0;

@@ -16,14 +16,14 @@ typedef struct {
   int nx;          /* one subsystem per coordinate */
 } law;
 
-static int f_sign(int sys, int mode, const double *x, const double *u, double *f, void *user) {
+static int f_sign(int sys, int mode, double t, const double *x, const double *u, double *f, void *user) {
   (void)x, (void)u;
   const law *L = user;
   memset(f, 0, (size_t)L->nx * sizeof(double));
   f[sys] = mode == 0 ? L->pos : L->neg;
   return 0;
 }
-static int c_sign(int sys, const double *x, const double *u, double *c, void *user) {
+static int c_sign(int sys, double t, const double *x, const double *u, double *c, void *user) {
   (void)u, (void)user;
   c[0] = x[sys];
   return 0;

@@ -8,13 +8,13 @@
  * the case is a chattering one); implicit standard time-stepping is reported alongside. */
 #include "hard_util.h"
 
-static int field(int sys, int mode, const double *x, const double *u, double *f, void *user) {
+static int field(int sys, int mode, double t, const double *x, const double *u, double *f, void *user) {
   (void)sys, (void)u, (void)user;
   f[0] = x[1];
   f[1] = mode == 0 ? -1.0 : 1.0; /* mode 0: s > 0 -> u = -1 */
   return 0;
 }
-static int sw(int sys, const double *x, const double *u, double *c, void *user) {
+static int sw(int sys, double t, const double *x, const double *u, double *c, void *user) {
   (void)sys, (void)u, (void)user;
   c[0] = x[0] + x[1];
   return 0;

@@ -11,7 +11,7 @@ typedef struct {
   double a_pos, a_neg; /* x2' for x2 > 0 / x2 < 0 */
 } law2;
 
-static int field(int sys, int mode, const double *x, const double *u, double *f, void *user) {
+static int field(int sys, int mode, double t, const double *x, const double *u, double *f, void *user) {
   (void)x, (void)u;
   const law2 *L = user;
   if (sys == 0) {
@@ -23,7 +23,7 @@ static int field(int sys, int mode, const double *x, const double *u, double *f,
   }
   return 0;
 }
-static int sw(int sys, const double *x, const double *u, double *c, void *user) {
+static int sw(int sys, double t, const double *x, const double *u, double *c, void *user) {
   (void)u, (void)user;
   c[0] = x[sys];
   return 0;

@@ -6,14 +6,14 @@
  * origin: the same per component. */
 #include "hard_util.h"
 
-static int field(int sys, int mode, const double *x, const double *u, double *f, void *user) {
+static int field(int sys, int mode, double t, const double *x, const double *u, double *f, void *user) {
   (void)x, (void)u;
   const int *nx = user;
   memset(f, 0, (size_t)*nx * sizeof(double));
   f[sys] = mode == 0 ? 1.0 : -1.0; /* mode 0: x > 0 */
   return 0;
 }
-static int sw(int sys, const double *x, const double *u, double *c, void *user) {
+static int sw(int sys, double t, const double *x, const double *u, double *c, void *user) {
   (void)u, (void)user;
   c[0] = x[sys];
   return 0;

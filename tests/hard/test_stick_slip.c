@@ -12,23 +12,23 @@
 
 static const double VB = 1.0, FR = 2.0, BETA = 0.1;
 
-static int field(int sys, int mode, const double *x, const double *u, double *f, void *user) {
+static int field(int sys, int mode, double t, const double *x, const double *u, double *f, void *user) {
   (void)sys, (void)u, (void)user;
   f[0] = x[1];
   f[1] = -x[0] + (mode == 0 ? -FR : FR) + BETA * (x[1] - VB);
   return 0;
 }
-static int field_jac(int sys, int mode, const double *x, const double *u, double *J, double *Ju, void *user) {
+static int field_jac(int sys, int mode, double t, const double *x, const double *u, double *J, double *Ju, void *user) {
   (void)sys, (void)mode, (void)x, (void)u, (void)Ju, (void)user;
   J[0] = 0, J[1] = -1, J[2] = 1, J[3] = BETA;
   return 0;
 }
-static int sw(int sys, const double *x, const double *u, double *c, void *user) {
+static int sw(int sys, double t, const double *x, const double *u, double *c, void *user) {
   (void)sys, (void)u, (void)user;
   c[0] = x[1] - VB;
   return 0;
 }
-static int sw_jac(int sys, const double *x, const double *u, double *J, double *Ju, void *user) {
+static int sw_jac(int sys, double t, const double *x, const double *u, double *J, double *Ju, void *user) {
   (void)sys, (void)x, (void)u, (void)Ju, (void)user;
   J[0] = 0, J[1] = 1;
   return 0;

@@ -14,13 +14,13 @@
 
 static const double K = 1e6;
 
-static int field(int sys, int mode, const double *x, const double *u, double *f, void *user) {
+static int field(int sys, int mode, double t, const double *x, const double *u, double *f, void *user) {
   (void)sys, (void)u, (void)user;
   f[0] = 1;
   f[1] = mode == 0 ? -K * (x[1] - cos(x[0])) : -1.0;
   return 0;
 }
-static int field_jac(int sys, int mode, const double *x, const double *u, double *J, double *Ju, void *user) {
+static int field_jac(int sys, int mode, double t, const double *x, const double *u, double *J, double *Ju, void *user) {
   (void)sys, (void)u, (void)Ju, (void)user;
   J[0] = 0;
   J[1] = mode == 0 ? -K * sin(x[0]) : 0;
@@ -28,7 +28,7 @@ static int field_jac(int sys, int mode, const double *x, const double *u, double
   J[3] = mode == 0 ? -K : 0;
   return 0;
 }
-static int sw(int sys, const double *x, const double *u, double *c, void *user) {
+static int sw(int sys, double t, const double *x, const double *u, double *c, void *user) {
   (void)sys, (void)u, (void)user;
   c[0] = x[1] - 0.5;
   return 0;

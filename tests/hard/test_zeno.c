@@ -14,14 +14,14 @@
 
 static const double A = 2.0, Bf = 1.0;
 
-static int field(int sys, int mode, const double *x, const double *u, double *f, void *user) {
+static int field(int sys, int mode, double t, const double *x, const double *u, double *f, void *user) {
   (void)u, (void)user;
   double sg = mode == 0 ? 1.0 : -1.0; /* mode 0: c > 0 */
   f[0] = sys == 0 ? x[1] : 0.0;
   f[1] = -(sys == 0 ? A : Bf) * sg;
   return 0;
 }
-static int sw(int sys, const double *x, const double *u, double *c, void *user) {
+static int sw(int sys, double t, const double *x, const double *u, double *c, void *user) {
   (void)u, (void)user;
   c[0] = x[sys];
   return 0;
