@@ -155,6 +155,19 @@ typedef struct {
 #define FESD_FLAG_NONUNIQUE 0x1 /**< the step started on a switching surface that the fields on
                                      both sides leave: the Filippov solution is not unique (the one
                                      returned stays on the surface) */
+#define FESD_FLAG_SENS_INACCURATE 0x2 /**< sensitivities on: the implicit-function system at the
+                                     accepted solution is singular or badly conditioned, or its
+                                     solve did not pass the residual check, or a complementarity
+                                     pair is degenerate (theta = lambda = 0 at a stage: the map is
+                                     not differentiable there); dx/dx0 and dx/du of this step are
+                                     not to be trusted (the state is) */
+#define FESD_FLAG_EXIT_NOT_PINNED 0x4 /**< a sliding exit was placed by a formulation that does
+                                     not pin it (exit_rows = 0, or a family whose last stage is not
+                                     the element end: Gauss-Legendre, explicit RK): its time is only
+                                     O(h) accurate */
+#define FESD_FLAG_COARSE 0x8    /**< the step's local error estimate exceeds its tolerance
+                                     (settings.coarse_tol, relative): the step is too long for the
+                                     accuracy of the solution */
 
 /** Statistics of one fesd_step() (accumulated over sub-steps when it splits). */
 typedef struct {
@@ -250,6 +263,10 @@ typedef struct {
   int fallback_steps;      /**< steps (or sub-steps) solved by the FB fallback path */
   int substeps;            /**< sub-steps of steps that held many switches */
   int nonunique_steps;     /**< steps flagged FESD_FLAG_NONUNIQUE */
+  int sens_inaccurate_steps; /**< steps flagged FESD_FLAG_SENS_INACCURATE */
+  int exit_not_pinned_steps; /**< steps flagged FESD_FLAG_EXIT_NOT_PINNED */
+  int coarse_steps;        /**< steps flagged FESD_FLAG_COARSE */
+  int failed_steps;        /**< calls of fesd_step that failed (their work is counted above) */
   int events;
   double time;             /**< wall-clock seconds in fesd_step */
   double max_iter_ordinary_step; /**< max Newton iterations of a step without switch */
