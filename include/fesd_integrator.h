@@ -188,6 +188,15 @@ typedef struct {
   const char *failed_callback; /**< on FESD_ERR_CALLBACK/NONFINITE: "field", "switch",
                                     "field_jac" or "switch_jac" */
   double failed_time;   /**< on failure: start time of the sub-step that failed */
+  const char *failed_path; /**< on failure: what failed last ("plan": the smooth solves with
+                                fixed active sets, then the FB fallback "fb"; "standard",
+                                "accept", "callback", "step"); NULL on success */
+  double failed_residual;  /**< on failure: residual (relative, as newton_tol) of the last failed
+                                solve */
+  double min_substep;      /**< shortest (sub)step length tried in this step (halvings and
+                                sub-steps; T when none) */
+  double last_time;        /**< end time of the last accepted sub-step (the step end on success;
+                                on failure the state is still rolled back to the step start) */
 } fesd_step_info;
 
 typedef struct fesd_integrator fesd_integrator; /**< opaque */

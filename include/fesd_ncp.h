@@ -235,6 +235,13 @@ FESD_API int fesd_ncp_rows(const fesd_ncp *ws);
 FESD_API int fesd_ncp_sensitivity(fesd_ncp *ws, const double *z, double sigma, int nrhs,
                                   const double *draw_dp, double *dz_dp);
 
+/** @brief Quality of the last fesd_ncp_sensitivity(): the worst relative residual
+ *         ||J dz + dF||_inf / max_i (sum_j |J_ij dz_j| + |dF_i|) over its right-hand sides,
+ *         after one step of iterative refinement when it exceeded 1e-12 (square systems; 0 for
+ *         least squares). Round-off gives about 1e-16; a value above ~1e-8 means the solve (and
+ *         the sensitivities) cannot be trusted. */
+FESD_API int fesd_ncp_sensitivity_residual(const fesd_ncp *ws, double *rel);
+
 /** @brief Free the workspace and set *ws = NULL. Accepts NULL and *ws == NULL. */
 FESD_API void fesd_ncp_free(fesd_ncp **ws);
 

@@ -77,6 +77,33 @@ static int start_jump(fesd_integrator *it, const double *z, int k) {
   return FESD_OK;
 }
 
+/* Relative residual of the implicit-function solve above which its result is not trusted
+ * (round-off gives ~1e-16; the refinement of src/ncp leaves ~1e-15 on sound systems). */
+#define SENS_RESIDUAL_MAX 1e-8
+
+/* A complementarity pair with theta and lambda both at zero at a stage point where no
+ * boundary row binds it: the active set is ambiguous there (a switch exactly at a stage
+ * point), the step map has one-sided derivatives only, and the implicit-function theorem on
+ * one active set gives one of them. The last stage before a switch boundary (its pair is the
+ * switch, bound by the cross-complementarity row or the pinned exit), a stage at the element
+ * start after one (c = 0), and the step end (the next step applies the saltation) are not
+ * degenerate. */
+static int degenerate_pair(fesd_integrator *it, const double *z) {
+  const fesd__system *S = &it->sys;
+  const int s = S->s, nth = S->nth;
+  for (int n = 0; n < S->N; n++)
+    for (int j = 0; j < s; j++) {
+      if (n == S->N - 1 && j == s - 1) continue;
+      if (j == s - 1 && it->bmode[n + 1] != 0) continue;
+      if (S->tab.c[j] == 0.0 && n > 0 && it->bmode[n] != 0) continue;
+      if (S->tab.c[j] == 0.0 && n == 0) continue; /* the step start: given */
+      const double *th = z + fesd__th(S, n, j), *la = z + fesd__la(S, n, j);
+      for (int i = 0; i < nth; i++)
+        if (fabs(th[i]) <= it->set.active_tol && fabs(la[i]) * S->wth[i] <= it->set.cc_tol) return 1;
+    }
+  return 0;
+}
+
 /* dx_end/d(x_start, u) of the accepted step by the implicit function theorem on the rows of
  * the last solve (the binding rows of the accepted solution), chained into Sx, Su. */
 static int chain_sensitivities(fesd_integrator *it, const double *z) {
@@ -99,6 +126,9 @@ static int chain_sensitivities(fesd_integrator *it, const double *z) {
   st = fesd_ncp_sensitivity(it->ncp, z, 0.0, np, L->draw, L->dz);
   if (st == FESD_ERR_CALLBACK && S->status) st = S->status; /* the model's own status */
   if (st) return st;
+  double rel = 0;
+  fesd_ncp_sensitivity_residual(it->ncp, &rel);
+  if (!(rel <= SENS_RESIDUAL_MAX) || degenerate_pair(it, z)) it->step_flags |= FESD_FLAG_SENS_INACCURATE;
   /* D = rows of x_N in dz: nx x np */
   const int xN = S->xo[S->N - 1];
   double *D = it->Dtmp;
@@ -179,9 +209,11 @@ static void add_event(fesd_integrator *it, double t, int k, const int *before, i
   e->after = after;
   if (subset(before, nb, after, na))
     e->kind = FESD_EVENT_SLIDING_ENTRY;
-  else if (subset(after, na, before, nb))
+  else if (subset(after, na, before, nb)) {
     e->kind = FESD_EVENT_SLIDING_EXIT;
-  else
+    /* pinned only by stiffly accurate methods with exit rows (plan.c) */
+    if (!it->set.exit_rows || it->sys.bp) it->step_flags |= FESD_FLAG_EXIT_NOT_PINNED;
+  } else
     e->kind = FESD_EVENT_CROSSING;
 }
 

@@ -342,6 +342,9 @@ int fesd_step(fesd_integrator *it, const double *u, double T, fesd_step_info *in
   fesd__save(it, &it->bk);
   it->model.failed = NULL;
   const double t_start = it->t;
+  it->step_flags = 0;
+  info->min_substep = T;
+  info->last_time = t_start;
   const long nomem0 = nomem_count(it);
   int st = fesd__substep(it, u, T, 0, info);
   /* an allocation that failed inside the step (the step may have gone on by another path
@@ -355,6 +358,16 @@ int fesd_step(fesd_integrator *it, const double *u, double T, fesd_step_info *in
     info->failed_time = it->t; /* start of the sub-step that failed */
     if (st == FESD_ERR_CALLBACK || st == FESD_ERR_NONFINITE) info->failed_callback = it->model.failed;
     fesd__load(it, &it->bk); /* the state is unchanged; no records */
+    if (!info->failed_path) info->failed_path = st == FESD_ERR_CALLBACK || st == FESD_ERR_NONFINITE ? "callback" : "step";
+    /* the work of a failed step counts */
+    fesd_stats *F = &it->stats;
+    F->failed_steps++;
+    F->newton_iter += info->newton_iter;
+    F->factorizations += info->factorizations;
+    F->solves += info->solves;
+    F->homotopy_stages += info->homotopy_stages;
+    F->splits += info->splits;
+    F->time += info->time;
     return st;
   }
   fesd_stats *S = &it->stats;
@@ -366,7 +379,13 @@ int fesd_step(fesd_integrator *it, const double *u, double T, fesd_step_info *in
   S->splits += info->splits;
   S->fallback_steps += info->fallback;
   S->substeps += info->substeps;
+  info->flags |= it->step_flags;
+  info->failed_path = NULL; /* a path that failed before another one succeeded */
+  info->failed_residual = 0;
   S->nonunique_steps += (info->flags & FESD_FLAG_NONUNIQUE) != 0;
+  S->sens_inaccurate_steps += (info->flags & FESD_FLAG_SENS_INACCURATE) != 0;
+  S->exit_not_pinned_steps += (info->flags & FESD_FLAG_EXIT_NOT_PINNED) != 0;
+  S->coarse_steps += (info->flags & FESD_FLAG_COARSE) != 0;
   S->events += it->n_events;
   S->time += info->time;
   int sw = info->switch_step || info->splits > 0 || info->substeps > 0;

@@ -89,6 +89,7 @@ struct fesd_integrator {
   int *jump_in, *jump_out; /* per subsystem: a switch exactly at the step start (mode entering,
                               mode left), or -1 */
   fesd__violation *scan_buf; /* nsys */
+  int step_flags;          /* FESD_FLAG_* of the current fesd_step */
   int nonunique;           /* the step started on a surface that the fields on both sides leave */
   /* the switch plan of the current (sub)step and the active set after each switch (rows of
    * nth flags; only the switch's subsystem is used) */

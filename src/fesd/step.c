@@ -47,10 +47,12 @@ static int hard_failure(int st) {
 static int rows_select(fesd_integrator *it, const int *switch_at) {
   fesd__system *S = &it->sys;
   memset(it->eq_active, 1, (size_t)S->n_eq);
+  memset(it->bmode, 0, (size_t)(S->N + 1) * sizeof(int));
   for (int k = 1; k < S->N; k++) {
     int sw = switch_at ? switch_at[k] : 0;
     it->eq_active[fesd__rowH(S, k)] = (unsigned char)!sw;
     it->eq_active[fesd__rowC(S, k)] = (unsigned char)(sw != 0);
+    it->bmode[k] = sw != 0;
   }
   memset(it->pair_mode, FESD_NCP_PAIR_FB, (size_t)S->n_pair);
   int st = fesd__set_border(it);
@@ -484,12 +486,18 @@ static int try_step(fesd_integrator *it, const double *u, double *T, fesd_step_i
   st = it->set.method == FESD_METHOD_FESD ? plan_path(it, T, info) : std_path(it, info);
   if (hard_failure(st)) return st;
   if (st != FESD_OK) {
+    info->failed_path = it->set.method == FESD_METHOD_FESD ? "plan" : "standard";
+    info->failed_residual = info->residual;
     *T = T_full;
     S->T = T_full;
     for (int k = 0; k < it->nsys; k++) it->jump_in[k] = it->jump_out[k] = -1;
     if ((st = fesd__use_level(it, it->set.n_fe))) return st;
     if ((st = set_h_bounds(it, *T, 0))) return st;
-    if ((st = fb_path(it, *T, info))) return st;
+    if ((st = fb_path(it, *T, info))) {
+      info->failed_path = "fb";
+      info->failed_residual = info->residual;
+      return st;
+    }
     info->fallback++;
   }
   double ccm = 0;
@@ -497,7 +505,9 @@ static int try_step(fesd_integrator *it, const double *u, double *T, fesd_step_i
     return st;
   info->cc_max = fesd__cc_max(S, it->z);
   if (it->nonunique) info->flags |= FESD_FLAG_NONUNIQUE;
-  return fesd__accept(it, it->z, u, *T);
+  st = fesd__accept(it, it->z, u, *T);
+  if (st) info->failed_path = "accept";
+  return st;
 }
 
 int fesd__substep(fesd_integrator *it, const double *u, double T, int depth, fesd_step_info *info) {
@@ -507,7 +517,9 @@ int fesd__substep(fesd_integrator *it, const double *u, double T, int depth, fes
     fesd__save(it, &it->bk_sub);
     const int fb = info->fallback;
     int st = try_step(it, u, &Ts, info);
+    if (Ts < info->min_substep) info->min_substep = Ts;
     if (st == FESD_OK) {
+      info->last_time = it->t;
       if (Ts < T - done) info->substeps++;
       done = Ts < T - done ? done + Ts : T;
       continue;
@@ -519,6 +531,7 @@ int fesd__substep(fesd_integrator *it, const double *u, double T, int depth, fes
       return st == FESD_ERR_TOO_MANY_SWITCHES || st == FESD_ERR_NONFINITE ? st : FESD_ERR_STEP_FAILED;
     info->splits++;
     const double R = T - done, half = 0.5 * R;
+    if (half < info->min_substep) info->min_substep = half;
     st = fesd__substep(it, u, half, depth + 1, info);
     if (st) return st;
     return fesd__substep(it, u, R - half, depth + 1, info);

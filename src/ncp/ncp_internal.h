@@ -58,6 +58,7 @@ struct fesd_ncp {
   int has_box;
 
   fesd__ncp_stats pending; /* sensitivity work, reported by the next solve */
+  double sens_residual;    /* worst relative residual of the last sensitivity solves */
 };
 
 /* assemble.c */
