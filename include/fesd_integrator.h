@@ -120,12 +120,18 @@ typedef struct {
   int max_sweeps;           /**< fixed-point sweeps that make the initial guess of a step
                                  consistent, [1, 50] (default 8; they stop early when
                                  converged or slow, and cost no Jacobian) */
+  double coarse_tol;        /**< a step whose local error estimate (relative, embedded, see
+                                 docs/solver.md) exceeds this is flagged FESD_FLAG_COARSE, [0, 1]
+                                 (default 1e-2; 0: no estimate) */
   int max_elements;         /**< most elements of one solve (FESD): a step that holds k
                                  switches gets max(n_fe, k + 1) elements (one boundary per
                                  switch); one that holds more than max_elements - 1 is solved
                                  in sub-steps that end between two switches. [2, 4096] (default
-                                 32; at least n_fe is used); memory grows with it (step data of
-                                 that many elements) */
+                                 8; at least n_fe is used). Each solve of a step with N elements
+                                 costs about N^2 / 2 element solves in the sparse LU (the Schur
+                                 complement on the element lengths), so larger values trade
+                                 sub-steps for costlier solves (measured on a friction chain with
+                                 many switches per step: 8 fastest of 4 .. 32) */
   fesd_ncp_settings ncp;    /**< linear algebra/line-search settings of the solver, ranges as
                                  in fesd_ncp.h; ncp.tol and ncp.max_iter are ignored (the
                                  integrator sets them from newton_tol, max_iter_first,
@@ -184,6 +190,8 @@ typedef struct {
   int fallback;         /**< sub-steps solved by the FB fallback path (active-set path failed) */
   double residual;      /**< final ||F||_inf of the accepted system */
   double cc_max;        /**< max cross-complementarity product of the accepted solution */
+  double error_estimate; /**< local error estimate of the step (relative; embedded estimate,
+                              max over elements; 0 when not computed) */
   double time;          /**< wall-clock seconds of the step */
   const char *failed_callback; /**< on FESD_ERR_CALLBACK/NONFINITE: "field", "switch",
                                     "field_jac" or "switch_jac" */

@@ -163,7 +163,7 @@ int fesd__initial_guess(fesd_integrator *it, const double *u, double T, double *
 /* theta of the stage for the active flags a at the evaluated point pe: the indicator of a
  * single mode; for a 2-mode sliding mode Filippov's multiplier (the convex combination
  * tangent to the surface, other subsystems at th), else uniform weights. */
-static void stage_theta(fesd_integrator *it, const fesd__point_eval *pe, const unsigned char *a,
+void fesd__stage_theta(fesd_integrator *it, const fesd__point_eval *pe, const unsigned char *a,
                         double *th) {
   const fesd__model *m = &it->model;
   for (int k = 0; k < m->nsys; k++) {
@@ -178,26 +178,29 @@ static void stage_theta(fesd_integrator *it, const fesd__point_eval *pe, const u
     any = cnt == 2;
   }
   if (!any) return;
+  /* several sliding subsystems (a co-dimension-2 sliding mode) are coupled: Gauss-Seidel
+   * sweeps over their 2-mode multipliers */
   double *ftot = it->ftot;
   fesd__total_field(it, pe, th, ftot);
-  for (int k = 0; k < m->nsys; k++) {
-    int i = -1, j = -1, cnt = 0;
-    for (int l = m->th_off[k]; l < m->th_off[k + 1]; l++)
-      if (a[l]) {
-        if (cnt++ == 0) i = l;
-        else j = l;
+  for (int sweep = 0; sweep < 4; sweep++)
+    for (int k = 0; k < m->nsys; k++) {
+      int i = -1, j = -1, cnt = 0;
+      for (int l = m->th_off[k]; l < m->th_off[k + 1]; l++)
+        if (a[l]) {
+          if (cnt++ == 0) i = l;
+          else j = l;
+        }
+      if (cnt != 2) continue;
+      double ai, aj;
+      fesd__normal_components(it, pe, th, ftot, i, j, &ai, &aj);
+      if (ai > 0 && aj < 0) { /* a sliding mode at this point */
+        const double ti = -aj / (ai - aj), tj = ai / (ai - aj);
+        fesd__F_axpy(m, pe, i, ti - th[i], ftot);
+        fesd__F_axpy(m, pe, j, tj - th[j], ftot);
+        th[i] = ti;
+        th[j] = tj;
       }
-    if (cnt != 2) continue;
-    double ai, aj;
-    fesd__normal_components(it, pe, th, ftot, i, j, &ai, &aj);
-    if (ai > 0 && aj < 0) { /* a sliding mode at this point */
-      const double ti = -aj / (ai - aj), tj = ai / (ai - aj);
-      fesd__F_axpy(m, pe, i, ti - th[i], ftot);
-      fesd__F_axpy(m, pe, j, tj - th[j], ftot);
-      th[i] = ti;
-      th[j] = tj;
     }
-  }
 }
 
 /* LP values of a stage block at the evaluated point: mu the theta-weighted indicator (so the
@@ -228,7 +231,7 @@ int fesd__regrid_guess(fesd_integrator *it, const double *zp, int Np, double *z)
       int st = fesd__model_eval(m, S->t0 + tn + S->tab.c[j] * h, X, S->u, &pe);
       if (st) return st;
       double *v = z + fesd__v(S, n, j), *th = z + fesd__th(S, n, j);
-      stage_theta(it, &pe, it->act + (size_t)(n * s + j) * nth, th);
+      fesd__stage_theta(it, &pe, it->act + (size_t)(n * s + j) * nth, th);
       memset(v, 0, (size_t)nx * sizeof(double));
       for (int i = 0; i < nth; i++)
         if (th[i] != 0.0) fesd__F_axpy(m, &pe, i, th[i], v);

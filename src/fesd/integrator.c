@@ -24,7 +24,8 @@ int fesd_settings_default(fesd_settings *s) {
   s->max_splits = 6;
   s->sensitivities = 0;
   s->max_sweeps = 8;
-  s->max_elements = 32;
+  s->max_elements = 8;
+  s->coarse_tol = 1e-2;
   fesd_ncp_settings_default(&s->ncp);
   return FESD_OK;
 }
@@ -45,6 +46,7 @@ static int validate_settings(const fesd_settings *s) {
   if (!int_in(s->exit_rows, 0, 1) || !int_in(s->sensitivities, 0, 1)) return FESD_ERR_INVALID_ARG;
   if (!int_in(s->max_splits, 0, 12) || !int_in(s->max_sweeps, 1, 50)) return FESD_ERR_INVALID_ARG;
   if (!int_in(s->max_elements, 2, 4096)) return FESD_ERR_INVALID_ARG;
+  if (!in_range(s->coarse_tol, 0.0, 1.0)) return FESD_ERR_INVALID_ARG;
   return FESD_OK;
 }
 
@@ -67,7 +69,7 @@ void fesd_free(fesd_integrator **itp) {
                     it->zpred, it->zp, it->raw,       it->lb,    it->ub,     it->Sx,    it->Su,
                     it->Dtmp, it->Stmp, it->gbuf,     it->blk,   it->vtmp,   it->pt_t,  it->pt_q,
                     it->pt_l, it->rec_h, it->rec_t,   it->rec_x, it->rec_th, it->rec_la, it->rec_mu,
-                    it->rec_v, it->zfast, it->bt, it->ftot, it->gdense, it->bseg_lo, it->bseg_hi, it->hlo, it->hhi};
+                    it->rec_v, it->zfast, it->bt, it->ftot, it->gdense, it->bseg_lo, it->bseg_hi, it->hlo, it->hhi, it->err_atol};
   for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); i++) free(bufs[i]);
   for (fesd__saved *b = &it->bk; b <= &it->bk_sub; b++) {
     double *saved[] = {b->x, b->lam, b->th, b->blk, b->Sx, b->Su, b->ldp};
@@ -167,6 +169,7 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   it->tab = tab;
   fesd_tableau_get(FESD_RK_GAUSS_LEGENDRE, tab.s, &it->quad);
   fesd__interior_setup(it);
+  fesd__error_setup(it);
   it->n = S->n; /* unknowns of the largest layout */
   it->nx = model->nx;
   it->nu = model->nu;
@@ -210,6 +213,7 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   it->blk = dalloc((size_t)S->sb, &fail);
   it->vtmp = dalloc(2 * nx, &fail);
   it->ftot = dalloc(nx, &fail);
+  it->err_atol = dalloc(nx, &fail);
   it->gdense = dalloc(nx, &fail); /* calloc: zero */
   if (fesd__point_alloc(&it->model, &it->pscr, 1)) fail = 1;
   it->pt_t = dalloc(N * (s + 1) + 1, &fail);

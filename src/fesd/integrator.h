@@ -110,6 +110,11 @@ struct fesd_integrator {
   int n_mid;
   double mid_w[(FESD_RK_MAX_STAGES + 1) * FESD_RK_MAX_STAGES];
   double mid_tau[FESD_RK_MAX_STAGES + 1];
+  /* error estimate (error.c): embedded weights (e0 on the field at the element start, e_j on
+   * the stages), order of the estimate */
+  int err_ok, err_q;
+  double err_e0, err_e[FESD_RK_MAX_STAGES];
+  double *err_atol; /* nx */
   fesd_event events[FESD_MAX_EVENTS_PER_STEP];
   int n_events;
   /* active-mode lists of the events (accept.c): ev_span = 2 x the largest n_modes ints per

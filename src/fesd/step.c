@@ -464,6 +464,26 @@ static int plan_path(fesd_integrator *it, double *T, fesd_step_info *info) {
   }
 }
 
+/* Flag a step whose local error estimate exceeds coarse_tol, relative to the size of each
+ * component (its largest value so far, on this step or before; at least 1e-6 of the largest
+ * component): a too coarse step shows without a reference solution. */
+static int coarse_check(fesd_integrator *it, fesd_step_info *info) {
+  const fesd__system *S = &it->sys;
+  double big = 0, *sz = it->err_atol;
+  for (int r = 0; r < it->nx; r++) {
+    sz[r] = fmax(S->refX[r], fabs(it->x[r]));
+    for (int n = 0; n < S->N; n++) sz[r] = fmax(sz[r], fabs(it->z[S->xo[n] + r]));
+    big = fmax(big, sz[r]);
+  }
+  for (int r = 0; r < it->nx; r++) sz[r] = it->set.coarse_tol * fmax(sz[r], 1e-6 * big) + 1e-300;
+  double err;
+  int st = fesd__error_estimate(it, it->z, 0.0, sz, &err);
+  if (st) return st;
+  info->error_estimate = fmax(info->error_estimate, err * it->set.coarse_tol);
+  if (!(err <= 1.0)) it->step_flags |= FESD_FLAG_COARSE;
+  return FESD_OK;
+}
+
 /* ---------- one attempt at a (sub)step of length *T (shortened when the step holds more
  *            switches than the largest layout) ---------- */
 
@@ -505,6 +525,7 @@ static int try_step(fesd_integrator *it, const double *u, double *T, fesd_step_i
     return st;
   info->cc_max = fesd__cc_max(S, it->z);
   if (it->nonunique) info->flags |= FESD_FLAG_NONUNIQUE;
+  if (it->set.coarse_tol > 0 && it->err_ok && (st = coarse_check(it, info))) return st;
   st = fesd__accept(it, it->z, u, *T);
   if (st) info->failed_path = "accept";
   return st;

@@ -52,6 +52,9 @@ void fesd__state_at(fesd_integrator *it, const double *z, int N, double t, doubl
 int fesd__initial_guess(fesd_integrator *it, const double *u, double T, double *z);
 int fesd__consistent_guess(fesd_integrator *it, double *z);
 void fesd__fill_element(fesd_integrator *it, double *z, int n, const double *block);
+/* theta of a stage for the active flags a at the evaluated point pe: the indicator of a single
+ * mode, Filippov's multiplier for a 2-mode sliding mode, else uniform weights. */
+void fesd__stage_theta(fesd_integrator *it, const fesd__point_eval *pe, const unsigned char *a, double *th);
 /* Guess for the current layout (it->act, h in z) from a solution zp on Np elements: states
  * from zp's polynomials at the new stage times, theta from the new active sets (sliding:
  * Filippov's multiplier at the state), lambda and mu from the indicators. */
@@ -85,6 +88,13 @@ void fesd__plan_truncate(fesd_integrator *it, double t);
 /* Time before which at most n_max switches of the plan lie (the end of a sub-step that holds
  * them): midway between switch n_max and the next (T when there are no more). */
 double fesd__plan_cut(fesd_integrator *it, int n_max);
+
+/* ---- error.c ---- */
+/* Embedded weights of the method (err_ok = 0: no estimate, explicit RK). */
+int fesd__error_setup(fesd_integrator *it);
+/* Local error estimate of the solution z of the current layout: weighted RMS norm of the
+ * embedded difference with weights 1 / (atol_r + rtol max|x|), max over the elements. */
+int fesd__error_estimate(fesd_integrator *it, const double *z, double rtol, const double *atol, double *err);
 
 /* ---- accept.c ---- */
 int fesd__accept(fesd_integrator *it, const double *z, const double *u, double T);

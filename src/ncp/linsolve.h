@@ -46,6 +46,8 @@ int fesd__ls_dense_lu_create(fesd__ls **ls, int n);
 int fesd__ls_dense_normal_create(fesd__ls **ls, int n);
 int fesd__ls_umfpack_create(fesd__ls **ls, int n);
 int fesd__ls_klu_create(fesd__ls **ls, int n);
+/* KLU: solve for nrhs right-hand sides at once (column-major, leading dimension n). */
+int fesd__ls_klu_solve_many(fesd__ls *ls, double *x, int nrhs);
 int fesd__ls_cholmod_create(fesd__ls **ls, int n);
 /* Bordered KLU (ls_border.c): nb rows and columns eliminated last by a Schur complement;
  * the flags (assembled rows, columns) are read at each analyze and must stay valid. */

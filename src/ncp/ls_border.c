@@ -128,8 +128,7 @@ static int bls_factor(fesd__ls *ls, double *values, double mu) {
   if (rc) return full_factor(b, values);
   memset(b->W, 0, (size_t)ni * nb * sizeof(double));
   for (int q = 0; q < b->nB; q++) b->W[(size_t)b->B_c[q] * ni + b->B_r[q]] = values[b->B_src[q]];
-  for (int c = 0; c < nb; c++)
-    if ((rc = b->inner->ops->solve(b->inner, b->W + (size_t)c * ni))) return rc;
+  if ((rc = fesd__ls_klu_solve_many(b->inner, b->W, nb))) return rc;
   memset(b->S, 0, (size_t)nb * nb * sizeof(double));
   for (int q = 0; q < b->nD; q++) b->S[(size_t)b->D_c[q] * nb + b->D_r[q]] += values[b->D_src[q]];
   for (int q = 0; q < b->nC; q++) {

@@ -156,6 +156,13 @@ static void kls_destroy(fesd__ls *ls) {
   free(k);
 }
 
+int fesd__ls_klu_solve_many(fesd__ls *ls, double *x, int nrhs) {
+  klu_ls *k = (klu_ls *)ls;
+  if (!k->cur || !k->cur->numeric) return FESD_ERR_LINSOLVE;
+  if (nrhs <= 0) return FESD_OK;
+  return klu_solve(k->cur->symbolic, k->cur->numeric, ls->n, nrhs, x, &k->common) ? FESD_OK : FESD_ERR_LINSOLVE;
+}
+
 static const fesd__ls_ops klu_ops = {FESD__LS_LU, FESD__LAYOUT_CSC, 0,          kls_analyze,
                                      kls_factor,  kls_solve,        kls_destroy};
 

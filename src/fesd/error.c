@@ -1,0 +1,106 @@
+/* Local error estimate of an accepted step, element by element. The solution is smooth inside
+ * each element (every switch sits on a boundary), so a classical embedded estimate applies:
+ * with the same stage derivatives v_j and the field at the element start f_0 (the active
+ * modes at x_n; Filippov's multiplier for a 2-mode sliding mode), a second quadrature
+ *   x^_{n+1} = x_n + h (b^_0 f_0 + sum_j b^_j v_j)
+ * on the nodes {0, c_1..c_{s-1}} (interpolatory: order s; the last stage is left out, since on
+ * {0, c_1..c_s} the interpolatory rule is the method's own; Lobatto methods, whose first node
+ * is 0 already, use {c_1..c_{s-1}}, order s - 1) differs from x_{n+1} by O(h^q),
+ * q = min(p^, p) + 1, p the method's order (s = 3 Radau IIA: q = 4, as the classical Radau5
+ * estimate). The estimate is the
+ * weighted RMS norm of x^ - x with weights 1 / (atol_r + rtol max(|x_n,r|, |x_n+1,r|)),
+ * maximised over the elements (explicit RK: no estimate). */
+#include <math.h>
+#include <string.h>
+
+#include "fesd/step.h"
+
+int fesd__error_setup(fesd_integrator *it) {
+  const fesd_tableau *T = &it->tab;
+  const int s = T->s;
+  double nodes[FESD_RK_MAX_STAGES + 1];
+  int m = 0, first = 0;
+  it->err_ok = 0;
+  if (T->is_explicit) return FESD_OK;
+  if (T->c[0] == 0.0) { /* Lobatto: the stages without the last */
+    for (int j = 0; j + 1 < s; j++) nodes[m++] = T->c[j];
+    first = 1;
+  } else {
+    nodes[m++] = 0.0;
+    for (int j = 0; j + 1 < s; j++) nodes[m++] = T->c[j];
+  }
+  if (m < 1) return FESD_OK;
+  /* interpolatory weights: sum_k w_k nodes_k^q = 1/(q+1), q < m (Vandermonde, Gauss
+   * elimination with partial pivoting; m <= 13) */
+  double V[FESD_RK_MAX_STAGES + 1][FESD_RK_MAX_STAGES + 2];
+  for (int q = 0; q < m; q++) {
+    for (int k = 0; k < m; k++) V[q][k] = pow(nodes[k], q);
+    V[q][m] = 1.0 / (q + 1);
+  }
+  for (int c = 0; c < m; c++) {
+    int p = c;
+    for (int r = c + 1; r < m; r++)
+      if (fabs(V[r][c]) > fabs(V[p][c])) p = r;
+    for (int k = 0; k <= m; k++) {
+      double t = V[c][k];
+      V[c][k] = V[p][k];
+      V[p][k] = t;
+    }
+    if (V[c][c] == 0.0) return FESD_OK;
+    for (int r = 0; r < m; r++) {
+      if (r == c) continue;
+      const double f = V[r][c] / V[c][c];
+      for (int k = c; k <= m; k++) V[r][k] -= f * V[c][k];
+    }
+  }
+  /* embedded weights in the stage layout: e0 for f_0, e[j] = bhat_j - b_j */
+  it->err_e0 = 0;
+  for (int j = 0; j < s; j++) it->err_e[j] = -T->b[j];
+  for (int k = 0; k < m; k++) {
+    const double w = V[k][m] / V[k][k];
+    if (first) it->err_e[k] += w;
+    else if (k == 0) it->err_e0 = w;
+    else it->err_e[k - 1] += w;
+  }
+  it->err_q = (m < T->order ? m : T->order) + 1; /* interpolatory on m nodes: order m */
+  it->err_ok = 1;
+  return FESD_OK;
+}
+
+int fesd__error_estimate(fesd_integrator *it, const double *z, double rtol, const double *atol, double *err) {
+  fesd__system *S = &it->sys;
+  fesd__model *m = &it->model;
+  const int nx = S->nx, s = S->s, nth = S->nth;
+  *err = 0;
+  if (!it->err_ok) return FESD_OK;
+  fesd__point_eval pe = {0};
+  pe.F = it->pscr.F;
+  pe.g = it->pscr.g;
+  pe.dgdx = it->pscr.dgdx;
+  double tn = S->t0, *f0 = it->ftot, *th0 = it->gbuf; /* nth */
+  for (int n = 0; n < S->N; n++) {
+    const double h = z[S->ho[n]], *xn = n == 0 ? S->x0 : z + S->xo[n - 1], *x1 = z + S->xo[n];
+    if (it->err_e0 != 0.0) {
+      int st = fesd__model_eval(m, tn, xn, S->u, &pe);
+      if (st) return st;
+      unsigned char *a = it->cand; /* the element's active modes (first stage) */
+      fesd__act_from_theta(it, z + fesd__th(S, n, 0), a);
+      fesd__stage_theta(it, &pe, a, th0);
+      fesd__total_field(it, &pe, th0, f0);
+    }
+    double sum = 0;
+    for (int r = 0; r < nx; r++) {
+      double d = it->err_e0 * (it->err_e0 != 0.0 ? f0[r] : 0.0);
+      for (int j = 0; j < s; j++) d += it->err_e[j] * z[fesd__v(S, n, j) + r];
+      d *= h;
+      const double sc = atol[r] + rtol * fmax(fabs(xn[r]), fabs(x1[r]));
+      const double e = sc > 0 ? d / sc : (d != 0 ? INFINITY : 0.0);
+      sum += e * e;
+    }
+    const double en = sqrt(sum / nx);
+    if (!(en <= *err)) *err = en; /* NaN propagates */
+    tn += h;
+    (void)nth;
+  }
+  return FESD_OK;
+}
