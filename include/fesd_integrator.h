@@ -47,6 +47,16 @@ typedef int (*fesd_switch_fn)(int sys, double t, const double *x, const double *
 typedef int (*fesd_switch_jac_fn)(int sys, double t, const double *x, const double *u, double *dcdx,
                                   double *dcdu, void *user);
 
+/** Drift f0(t,x,u): the part of x' shared by all modes (x' = f0 + sum_k F^k theta^k); writes
+ *  nx values (or n_rows values of model.drift_sparsity). */
+typedef int (*fesd_drift_fn)(double t, const double *x, const double *u, double *f0, void *user);
+/** Jacobians of the drift (layouts as fesd_field_jac_fn). */
+typedef int (*fesd_drift_jac_fn)(double t, const double *x, const double *u, double *dfdx, double *dfdu,
+                                 void *user);
+/** Stop conditions r(t,x,u): write model.n_roots values. An integration stops where one crosses
+ *  zero in its direction (fesd_integrate). */
+typedef int (*fesd_root_fn)(double t, const double *x, const double *u, double *r, void *user);
+
 /**
  * Optional sparsity of one subsystem, for large n_x (all indices 0-based). With it the
  * callbacks of that subsystem work on compressed data:
@@ -88,6 +98,19 @@ typedef struct {
   fesd_switch_jac_fn sw_jac;    /**< optional: NULL = central finite differences */
   void *user;                   /**< passed to every callback */
   const fesd_sparsity *sparsity; /**< [nsys] optional (NULL = dense callbacks) */
+  int time_dependent;           /**< 0: the callbacks do not depend on t (they still receive it);
+                                     1: they do: t is then carried as an internal state so that
+                                     the element lengths see it (d/dt by central differences) */
+  fesd_drift_fn drift;          /**< optional smooth part shared by all modes, evaluated once per
+                                     point instead of once per mode (NULL: none) */
+  fesd_drift_jac_fn drift_jac;  /**< optional (NULL: central differences; required with
+                                     sparsity) */
+  const fesd_sparsity *drift_sparsity; /**< rows and df0/dx pattern of the drift (sparse models;
+                                     sw_* ignored); NULL: dense */
+  int n_roots;                  /**< stop conditions (>= 0) */
+  fesd_root_fn roots;           /**< required when n_roots > 0 */
+  const int *root_dir;          /**< [n_roots]: +1 stop when r_i increases through 0, -1 when it
+                                     decreases, 0 both (NULL: all 0) */
 } fesd_model;
 
 typedef enum {
@@ -141,7 +164,9 @@ typedef struct {
 typedef enum {
   FESD_EVENT_CROSSING = 0,       /**< active set replaced (transversal crossing) */
   FESD_EVENT_SLIDING_ENTRY = 1,  /**< active set grows (reaching a sliding surface) */
-  FESD_EVENT_SLIDING_EXIT = 2    /**< active set shrinks (leaving a sliding surface) */
+  FESD_EVENT_SLIDING_EXIT = 2,   /**< active set shrinks (leaving a sliding surface) */
+  FESD_EVENT_ROOT = 3            /**< a stop condition crosses zero (sys: its index; before/after:
+                                      {1} -> {0} when it increases, {0} -> {1} when it decreases) */
 } fesd_event_kind;
 
 /** A detected switch at an element boundary: the set of active modes (theta_i >
@@ -254,12 +279,14 @@ typedef struct {
   int n_elements;         /**< elements of the accepted step (N_FE times the sub-steps) */
   const double *h;        /**< element lengths */
   const double *t;        /**< element start times (n_elements + 1 entries, last = step end) */
-  const double *x;        /**< boundary states, (n_elements + 1) x nx row-wise */
+  const double *x;        /**< boundary states, (n_elements + 1) rows of nx (below) */
   const double *theta;    /**< stage theta, n_elements x s x n_theta */
   const double *lambda;   /**< stage lambda, n_elements x s x n_theta */
   const double *mu;       /**< stage mu, n_elements x s x nsys */
-  int n_theta;            /**< total modes (sum of n_modes) */
+  int n_theta;            /**< stride of theta, lambda: total modes (sum of n_modes; with a
+                               drift or stop conditions their internal modes follow the user's) */
   int stages;
+  int nx;                 /**< stride of x: states (with time_dependent the time follows them) */
 } fesd_step_data;
 
 /** @brief Element data of the last accepted step (pointers valid until the next step). */
@@ -274,6 +301,58 @@ FESD_API int fesd_last_step_data(const fesd_integrator *it, fesd_step_data *data
  */
 FESD_API int fesd_dense_output(const fesd_integrator *it, double t, double *x);
 
+/** Error control of fesd_integrate (fesd_set_tolerances; fesd_tolerances_default fills the
+ *  defaults). The local error of every element is estimated (embedded formula, docs/solver.md)
+ *  and kept below atol_r + rtol |x_r| (weighted RMS norm); tolerances are transformed so that
+ *  the achieved error follows them. */
+typedef struct {
+  double rtol;          /**< relative tolerance, [1e-14, 0.5] (default 1e-6) */
+  double atol;          /**< absolute tolerance in the units of x, >= 0 (default 1e-9) */
+  const double *atol_v; /**< optional per-state absolute tolerances (nx; copied; NULL: atol) */
+  double h_init;        /**< first step length (0: estimated from the field) */
+  double h_max;         /**< longest step (0: no limit) */
+  double h_min;         /**< shortest step before FESD_ERR_STEP_TOO_SMALL (0: 1e-14 |t|) */
+  int max_steps;        /**< accepted + rejected steps per call, >= 1 (default 100000) */
+} fesd_tolerances;
+
+/** Statistics of one fesd_integrate / fesd_integrate_grid call. */
+typedef struct {
+  int status;           /**< FESD_OK, FESD_ROOT or a negative fesd_status */
+  double t;             /**< time reached */
+  int steps;            /**< accepted steps */
+  int rejected;         /**< steps rejected by the error test */
+  int failed_attempts;  /**< steps without a solution, retried shorter */
+  int newton_iter;      /**< Newton iterations of all attempts */
+  int root;             /**< on FESD_ROOT: the stop condition's index (else -1) */
+  int n_done;           /**< fesd_integrate_grid: output times filled */
+  double h_next;        /**< proposed next step length */
+} fesd_integrate_info;
+
+/** @brief Defaults of the error control. */
+FESD_API int fesd_tolerances_default(fesd_tolerances *tol);
+/** @brief Set the error control of fesd_integrate (validated; FESD_ERR_UNSUPPORTED_TABLEAU for
+ *         explicit RK, which has no estimate). Without it the defaults are used. */
+FESD_API int fesd_set_tolerances(fesd_integrator *it, const fesd_tolerances *tol);
+/**
+ * @brief Integrate from the current state to t_out with error-controlled steps, landing on t_out.
+ *        Stops earlier, returning FESD_ROOT, where a stop condition (model.roots) crosses zero in
+ *        its direction: the state is then on the root (located like a switch, to the method's
+ *        accuracy); calling again continues from there. Events of every step go to the event log.
+ * @return FESD_OK, FESD_ROOT, or the failure (the state is the last accepted one).
+ */
+FESD_API int fesd_integrate(fesd_integrator *it, const double *u, double t_out, fesd_integrate_info *info);
+/**
+ * @brief States at n increasing output times (x_out: n rows of nx): error-controlled steps to
+ *        t_out[n-1]; outputs inside a step from the collocation polynomial (Radau IIA,
+ *        Gauss-Legendre, Lobatto IIIA), else by landing on each. FESD_ROOT as fesd_integrate
+ *        (info->n_done outputs filled).
+ */
+FESD_API int fesd_integrate_grid(fesd_integrator *it, const double *u, int n, const double *t_out, double *x_out,
+                                 fesd_integrate_info *info);
+/** @brief All events since fesd_set_state that fesd_integrate accepted (pointers valid until
+ *         the next integration call or fesd_set_state). */
+FESD_API int fesd_event_log(const fesd_integrator *it, const fesd_event **events, int *count);
+
 /** Accumulated statistics since fesd_set_state. */
 typedef struct {
   int steps, switch_steps, newton_iter, factorizations, solves, homotopy_stages, splits;
@@ -284,6 +363,7 @@ typedef struct {
   int exit_not_pinned_steps; /**< steps flagged FESD_FLAG_EXIT_NOT_PINNED */
   int coarse_steps;        /**< steps flagged FESD_FLAG_COARSE */
   int failed_steps;        /**< calls of fesd_step that failed (their work is counted above) */
+  int rejected_steps;      /**< steps rejected by the error test of fesd_integrate */
   int events;
   double time;             /**< wall-clock seconds in fesd_step */
   double max_iter_ordinary_step; /**< max Newton iterations of a step without switch */

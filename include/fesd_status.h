@@ -2,7 +2,7 @@
  * @file fesd_status.h
  * @brief Status codes of libfesd and their human-readable strings.
  *
- * Convention: 0 = success, negative = failure. Every public function that can
+ * Convention: 0 = success, negative = failure, positive = success with a note (FESD_ROOT). Every public function that can
  * fail returns one of these codes; fesd_status_string() turns it into text.
  */
 #ifndef FESD_STATUS_H
@@ -20,6 +20,7 @@ extern "C" {
 
 /* X-macro: (name, value, message). One list gives the enum and the strings. */
 #define FESD_STATUS_LIST(X)                                                              \
+  X(FESD_ROOT, 1, "stopped where a stop condition crossed zero (fesd_integrate)")        \
   X(FESD_OK, 0, "success")                                                               \
   X(FESD_ERR_NULL, -1, "a required pointer argument is NULL")                            \
   X(FESD_ERR_INVALID_ARG, -2, "invalid argument or setting")                             \
@@ -38,7 +39,9 @@ extern "C" {
   X(FESD_ERR_TOO_MANY_SWITCHES, -15, "too many switches (Zeno-like accumulation): stopped") \
   X(FESD_ERR_SIGN_MATRIX, -16, "sign matrix has repeated rows or zero entries")         \
   X(FESD_ERR_MODEL, -17, "invalid model (missing callback or bad dimensions)")          \
-  X(FESD_ERR_NOT_READY, -18, "object is not in a state that allows this call")
+  X(FESD_ERR_NOT_READY, -18, "object is not in a state that allows this call")          \
+  X(FESD_ERR_TOO_MANY_STEPS, -19, "maximum number of steps reached before the output time") \
+  X(FESD_ERR_STEP_TOO_SMALL, -20, "step size fell below its minimum (error or convergence failures)")
 
 typedef enum {
 #define FESD_X_ENUM(name, value, msg) name = value,

@@ -207,7 +207,10 @@ static void add_event(fesd_integrator *it, double t, int k, const int *before, i
   e->n_after = na;
   e->before = before;
   e->after = after;
-  if (subset(before, nb, after, na))
+  if (k >= it->nsysu) { /* a stop condition (the drift has one mode: no events) */
+    e->kind = FESD_EVENT_ROOT;
+    e->sys = k - it->wrap.kr;
+  } else if (subset(before, nb, after, na))
     e->kind = FESD_EVENT_SLIDING_ENTRY;
   else if (subset(after, na, before, nb)) {
     e->kind = FESD_EVENT_SLIDING_EXIT;

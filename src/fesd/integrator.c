@@ -65,11 +65,14 @@ void fesd_free(fesd_integrator **itp) {
   fesd__point_free(&it->pscr);
   fesd__system_free(&it->sys);
   fesd__model_free(&it->model);
+  fesd__wrap_free(&it->wrap);
+  free(it->log);
+  free(it->log_pool);
   double *bufs[] = {it->x,  it->lam00, it->theta_prev, it->u_cur, it->ws_blk, it->z,     it->z0,
                     it->zpred, it->zp, it->raw,       it->lb,    it->ub,     it->Sx,    it->Su,
                     it->Dtmp, it->Stmp, it->gbuf,     it->blk,   it->vtmp,   it->pt_t,  it->pt_q,
                     it->pt_l, it->rec_h, it->rec_t,   it->rec_x, it->rec_th, it->rec_la, it->rec_mu,
-                    it->rec_v, it->zfast, it->bt, it->ftot, it->gdense, it->bseg_lo, it->bseg_hi, it->hlo, it->hhi, it->err_atol};
+                    it->rec_v, it->zfast, it->bt, it->ftot, it->gdense, it->bseg_lo, it->bseg_hi, it->hlo, it->hhi, it->err_atol, it->tol_atol};
   for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); i++) free(bufs[i]);
   for (fesd__saved *b = &it->bk; b <= &it->bk_sub; b++) {
     double *saved[] = {b->x, b->lam, b->th, b->blk, b->Sx, b->Su, b->ldp};
@@ -155,13 +158,28 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   fesd_integrator *it = calloc(1, sizeof(*it));
   if (!it) return FESD_ERR_NOMEM;
   it->set = *settings;
-  if ((st = fesd__model_init(&it->model, model))) {
+  if (model->nsys >= 1 && model->n_modes)
+    for (int k = 0; k < model->nsys; k++)
+      if (model->n_modes[k] < 2) {
+        free(it);
+        return FESD_ERR_MODEL;
+      }
+  fesd_model internal;
+  if ((st = fesd__wrap_init(&it->wrap, model, &internal))) {
     free(it);
     return st;
   }
+  if ((st = fesd__model_init(&it->model, &internal))) {
+    fesd__wrap_free(&it->wrap);
+    free(it);
+    return st;
+  }
+  it->nxu = model->nx;
+  it->nsysu = model->nsys;
   it->N_cap = settings->max_elements > settings->n_fe ? settings->max_elements : settings->n_fe;
   if ((st = fesd__system_init(&it->sys, &it->model, &tab, it->N_cap, settings->sensitivities))) {
     fesd__model_free(&it->model);
+    fesd__wrap_free(&it->wrap);
     free(it);
     return st;
   }
@@ -171,10 +189,10 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   fesd__interior_setup(it);
   fesd__error_setup(it);
   it->n = S->n; /* unknowns of the largest layout */
-  it->nx = model->nx;
+  it->nx = internal.nx;
   it->nu = model->nu;
   it->nth = it->model.nth;
-  it->nsys = model->nsys;
+  it->nsys = internal.nsys;
   it->s = S->s;
   it->np = it->nx + it->nu;
   const size_t n = (size_t)S->n, nx = (size_t)it->nx, nu = (size_t)it->nu, nth = (size_t)it->nth;
@@ -214,6 +232,7 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   it->vtmp = dalloc(2 * nx, &fail);
   it->ftot = dalloc(nx, &fail);
   it->err_atol = dalloc(nx, &fail);
+  it->tol_atol = dalloc(nx, &fail);
   it->gdense = dalloc(nx, &fail); /* calloc: zero */
   if (fesd__point_alloc(&it->model, &it->pscr, 1)) fail = 1;
   it->pt_t = dalloc(N * (s + 1) + 1, &fail);
@@ -267,10 +286,11 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
 int fesd_set_state(fesd_integrator *it, double t0, const double *x0, const double *u) {
   if (!it || !x0 || (it->nu > 0 && !u)) return FESD_ERR_NULL;
   if (!isfinite(t0)) return FESD_ERR_INVALID_ARG;
-  for (int i = 0; i < it->nx; i++)
+  for (int i = 0; i < it->nxu; i++)
     if (!isfinite(x0[i])) return FESD_ERR_INVALID_ARG;
   it->t = t0;
-  memcpy(it->x, x0, (size_t)it->nx * sizeof(double));
+  memcpy(it->x, x0, (size_t)it->nxu * sizeof(double));
+  if (it->wrap.td) it->x[it->nxu] = t0; /* time as the last state */
   it->have_ws = 0;
   it->have_prev_theta = 0;
   fesd__system_reset_refs(&it->sys);
@@ -283,8 +303,11 @@ int fesd_set_state(fesd_integrator *it, double t0, const double *x0, const doubl
   it->sum_iter_ord = it->sum_iter_sw = 0;
   it->n_el = 0;
   it->n_events = 0;
+  it->h_next = 0;
+  it->log_n = 0;
+  it->log_pool_n = 0;
   /* lambda00 = g(x0) - min g (paper Sec. 3.2.2), with its derivative for sensitivities */
-  int st = fesd__update_lambda00(it, x0, u, it->set.sensitivities);
+  int st = fesd__update_lambda00(it, it->x, u, it->set.sensitivities);
   it->have_state = (st == FESD_OK);
   return st;
 }
@@ -354,7 +377,10 @@ int fesd_step(fesd_integrator *it, const double *u, double T, fesd_step_info *in
   /* an allocation that failed inside the step (the step may have gone on by another path
    * or by halving) fails the step: its result would differ from the one of a clean run */
   if (nomem_count(it) != nomem0) st = FESD_ERR_NOMEM;
-  if (st == FESD_OK) it->t = t_start + T; /* sub-steps add up to T up to round-off */
+  if (st == FESD_OK) {
+    it->t = t_start + T; /* sub-steps add up to T up to round-off */
+    if (it->wrap.td) it->x[it->nxu] = it->t;
+  }
   info->time = fesd__wall_time() - t0;
   info->status = st;
   if (st != FESD_ERR_CALLBACK && st != FESD_ERR_NONFINITE) info->failed_callback = NULL;
@@ -410,15 +436,18 @@ int fesd_step(fesd_integrator *it, const double *u, double T, fesd_step_info *in
 int fesd_get_state(const fesd_integrator *it, double *t, double *x) {
   if (!it) return FESD_ERR_NULL;
   if (t) *t = it->t;
-  if (x) memcpy(x, it->x, (size_t)it->nx * sizeof(double));
+  if (x) memcpy(x, it->x, (size_t)it->nxu * sizeof(double));
   return FESD_OK;
 }
 
 int fesd_get_sensitivities(const fesd_integrator *it, double *Sx, double *Su) {
   if (!it) return FESD_ERR_NULL;
   if (!it->set.sensitivities) return FESD_ERR_NOT_READY;
-  if (Sx) memcpy(Sx, it->Sx, (size_t)it->nx * it->nx * sizeof(double));
-  if (Su && it->nu > 0) memcpy(Su, it->Su, (size_t)it->nx * it->nu * sizeof(double));
+  const int nx = it->nx, m = it->nxu; /* the user's block of the internal matrices */
+  if (Sx)
+    for (int c = 0; c < m; c++) memcpy(Sx + (size_t)c * m, it->Sx + (size_t)c * nx, (size_t)m * sizeof(double));
+  if (Su)
+    for (int c = 0; c < it->nu; c++) memcpy(Su + (size_t)c * m, it->Su + (size_t)c * nx, (size_t)m * sizeof(double));
   return FESD_OK;
 }
 
@@ -440,6 +469,7 @@ int fesd_last_step_data(const fesd_integrator *it, fesd_step_data *d) {
   d->mu = it->rec_mu;
   d->n_theta = it->nth;
   d->stages = it->s;
+  d->nx = it->nx;
   return FESD_OK;
 }
 
@@ -452,7 +482,7 @@ int fesd_get_stats(const fesd_integrator *it, fesd_stats *stats) {
 int fesd_dims(const fesd_integrator *it, int *n_theta, int *nsys) {
   if (!it) return FESD_ERR_NULL;
   if (n_theta) *n_theta = it->nth;
-  if (nsys) *nsys = it->nsys;
+  if (nsys) *nsys = it->nsysu;
   return FESD_OK;
 }
 
@@ -471,14 +501,14 @@ int fesd_dense_output(const fesd_integrator *it, double t, double *x) {
   if (!(t >= t0 - tol && t <= t1 + tol)) return FESD_ERR_INVALID_ARG;
   int e = 0;
   while (e + 1 < it->n_el && t >= it->rec_t[e + 1]) e++;
-  const int s = T->s, nx = it->nx;
+  const int s = T->s, nx = it->nx, m = it->nxu;
   const double h = it->rec_h[e], tau = h > 0 ? fmin(fmax((t - it->rec_t[e]) / h, 0.0), 1.0) : 0.0;
   double w[FESD_RK_MAX_STAGES];
   fesd__colloc_weights(it, tau, w);
-  memcpy(x, it->rec_x + (size_t)e * nx, (size_t)nx * sizeof(double));
+  memcpy(x, it->rec_x + (size_t)e * nx, (size_t)m * sizeof(double));
   for (int j = 0; j < s; j++) {
     const double *v = it->rec_v + ((size_t)e * s + j) * nx;
-    for (int r = 0; r < nx; r++) x[r] += h * w[j] * v[r];
+    for (int r = 0; r < m; r++) x[r] += h * w[j] * v[r];
   }
   return FESD_OK;
 }

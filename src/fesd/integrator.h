@@ -6,6 +6,7 @@
 
 #include "fesd/model.h"
 #include "fesd/system.h"
+#include "fesd/wrap.h"
 #include "fesd_integrator.h"
 #include "fesd_ncp.h"
 
@@ -61,6 +62,8 @@ typedef struct {
 
 struct fesd_integrator {
   fesd_settings set;
+  fesd__wrap wrap;  /* the internal model (time as state, drift, roots: wrap.h) */
+  int nxu, nsysu;   /* the user's states and subsystems (nx, nsys: internal) */
   fesd__model model;
   fesd__system sys;
   fesd_ncp *ncp; /* the workspace of the current layout (a level's) */
@@ -115,6 +118,15 @@ struct fesd_integrator {
   int err_ok, err_q;
   double err_e0, err_e[FESD_RK_MAX_STAGES];
   double *err_atol; /* nx */
+  /* error-controlled integration (integrate.c) */
+  fesd_tolerances tol;
+  double *tol_atol; /* nx */
+  int have_tol, ec_on;
+  double ec_rtol, h_next;
+  fesd_event *log;
+  int *log_pool;
+  int log_n, log_cap;
+  size_t log_pool_n, log_pool_cap;
   fesd_event events[FESD_MAX_EVENTS_PER_STEP];
   int n_events;
   /* active-mode lists of the events (accept.c): ev_span = 2 x the largest n_modes ints per

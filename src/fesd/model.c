@@ -228,7 +228,7 @@ int fesd__model_init(fesd__model *m, const fesd_model *u) {
     goto fail;
   for (int k = 0; k < K; k++) {
     int nf = u->n_modes[k], nc = u->n_switch ? u->n_switch[k] : 0;
-    if (nf < 2 || nc < 0) {
+    if (nf < 1 || nc < 0) { /* (user subsystems need 2: checked by fesd_create) */
       st = FESD_ERR_MODEL;
       goto fail;
     }

@@ -525,7 +525,13 @@ static int try_step(fesd_integrator *it, const double *u, double *T, fesd_step_i
     return st;
   info->cc_max = fesd__cc_max(S, it->z);
   if (it->nonunique) info->flags |= FESD_FLAG_NONUNIQUE;
-  if (it->set.coarse_tol > 0 && it->err_ok && (st = coarse_check(it, info))) return st;
+  if (it->ec_on) { /* error control (integrate.c): the estimate against the transformed tolerances */
+    double err;
+    if ((st = fesd__error_estimate(it, it->z, it->ec_rtol, it->err_atol, &err))) return st;
+    info->error_estimate = fmax(info->error_estimate, err);
+  } else if (it->set.coarse_tol > 0 && it->err_ok && (st = coarse_check(it, info))) {
+    return st;
+  }
   st = fesd__accept(it, it->z, u, *T);
   if (st) info->failed_path = "accept";
   return st;

@@ -254,13 +254,12 @@ static int ocp_exact(double t, double *x) {
 
 static const char *const names[] = {"oscillator", "sign-a",       "sign-b",       "sign-c",
                                     "sign-d",     "nonlipschitz", "ocp-dynamics", "stewart-anitescu",
-                                    "slide-exit-2d", NULL};
+                                    "slide-exit-2d", "stick-slip", NULL};
 
 const char *const *fesd_problem_names(void) { return names; }
 
 static void scalar_problem(fesd_problem *p, const scalar_law *law, double x0, double T) {
-  p->model = (fesd_model){2, 0, 1, one_sys_two_modes, one_switch, NULL, scalar_field,
-                          scalar_field_jac, scalar_sw, scalar_sw_jac, (void *)law, NULL};
+  p->model = (fesd_model){.nx = 2, .nu = 0, .nsys = 1, .n_modes = one_sys_two_modes, .n_switch = one_switch, .sign = NULL, .field = scalar_field, .field_jac = scalar_field_jac, .sw = scalar_sw, .sw_jac = scalar_sw_jac, .user = (void *)law, .sparsity = NULL};
   p->x0[0] = x0;
   p->x0[1] = 0;
   p->T = T;
@@ -273,12 +272,22 @@ int fesd_problem_get(const char *name, fesd_problem *p) {
   if (!strcmp(name, "oscillator")) {
     p->name = "oscillator";
     p->description = "x' = A1 x outside / A2 x inside the unit circle; crossing at t = 1";
-    p->model = (fesd_model){2, 0, 1, one_sys_two_modes, one_switch, NULL, osc_field, osc_field_jac,
-                            osc_sw, osc_sw_jac, NULL, NULL};
+    p->model = (fesd_model){.nx = 2, .nu = 0, .nsys = 1, .n_modes = one_sys_two_modes, .n_switch = one_switch, .sign = NULL, .field = osc_field, .field_jac = osc_field_jac, .sw = osc_sw, .sw_jac = osc_sw_jac, .user = NULL, .sparsity = NULL};
     p->x0[0] = exp(-1.0);
     p->T = PI / 2;
     p->t_switch = 1.0;
     p->exact = fesd_problem_oscillator_exact;
+  } else if (!strcmp(name, "stick-slip")) {
+    p->name = "stick-slip";
+    p->description = "friction oscillator on a belt: stuck until t = 2, then a stick-slip cycle";
+    p->model = (fesd_model){.nx = 2, .nsys = 1, .n_modes = one_sys_two_modes, .n_switch = one_switch,
+                            .field = fesd_stick_slip_field, .field_jac = fesd_stick_slip_field_jac,
+                            .sw = fesd_stick_slip_sw, .sw_jac = fesd_stick_slip_sw_jac};
+    p->x0[0] = 0;
+    p->x0[1] = 1;
+    p->T = 2 + 3 * fesd_stick_slip_reference().period;
+    p->t_switch = 2.0;
+    p->exact = fesd_stick_slip_exact;
   } else if (!strcmp(name, "sign-a")) {
     p->name = "sign-a";
     p->description = "x' in 2 - sign(x), x0 = -1: crossing at t = 1/3";
@@ -308,8 +317,7 @@ int fesd_problem_get(const char *name, fesd_problem *p) {
   } else if (!strcmp(name, "ocp-dynamics")) {
     p->name = "ocp-dynamics";
     p->description = "q' = -sign(c(q)) + v, v' = u = 0: sliding on c1 = 0, then on c = 0";
-    p->model = (fesd_model){4, 2, 2, two_sys_modes, two_sys_switch, NULL, ocp_field, ocp_field_jac,
-                            ocp_sw, ocp_sw_jac, NULL, NULL};
+    p->model = (fesd_model){.nx = 4, .nu = 2, .nsys = 2, .n_modes = two_sys_modes, .n_switch = two_sys_switch, .sign = NULL, .field = ocp_field, .field_jac = ocp_field_jac, .sw = ocp_sw, .sw_jac = ocp_sw_jac, .user = NULL, .sparsity = NULL};
     p->x0[0] = 2 * PI / 3;
     p->x0[1] = PI / 3;
     p->T = 4.0;
@@ -318,16 +326,14 @@ int fesd_problem_get(const char *name, fesd_problem *p) {
   } else if (!strcmp(name, "stewart-anitescu")) {
     p->name = "stewart-anitescu";
     p->description = "x' in 2 - sign(x), q' = x^2 (running cost), x0 = (-1, 0), T = 2";
-    p->model = (fesd_model){2, 0, 1, one_sys_two_modes, one_switch, NULL, sa_field, sa_field_jac,
-                            scalar_sw, scalar_sw_jac, NULL, NULL};
+    p->model = (fesd_model){.nx = 2, .nu = 0, .nsys = 1, .n_modes = one_sys_two_modes, .n_switch = one_switch, .sign = NULL, .field = sa_field, .field_jac = sa_field_jac, .sw = scalar_sw, .sw_jac = scalar_sw_jac, .user = NULL, .sparsity = NULL};
     p->x0[0] = -1.0;
     p->T = 2.0;
     p->t_switch = 1.0 / 3;
   } else if (!strcmp(name, "slide-exit-2d")) {
     p->name = "slide-exit-2d";
     p->description = "slides on c = x1 + x2^2/2 from x0 = 0, leaves it at t = 1.02617735";
-    p->model = (fesd_model){2, 0, 1, one_sys_two_modes, one_switch, NULL, se_field, se_field_jac,
-                            se_sw, se_sw_jac, NULL, NULL};
+    p->model = (fesd_model){.nx = 2, .nu = 0, .nsys = 1, .n_modes = one_sys_two_modes, .n_switch = one_switch, .sign = NULL, .field = se_field, .field_jac = se_field_jac, .sw = se_sw, .sw_jac = se_sw_jac, .user = NULL, .sparsity = NULL};
     p->T = 2.1;
     double x2;
     fesd_problem_slide_exit_point(&p->t_switch, &x2);

@@ -44,4 +44,17 @@ double fesd_sa_exact_value(double x0, double *dV);
 int fesd_sa_value(fesd_integrator *it, double x0, int nsim, double *V, double *dV);
 int fesd_sa_shoot(fesd_integrator *it, double x_start, int nsim, double *x_opt, int *iters);
 
+/* stick-slip (stick_slip.c): friction oscillator on a belt, periodic stick-slip cycle from
+ * x0 = (0, 1): stuck until t = 2, then slip phases of tau_slip and stick phases, period P. */
+typedef struct {
+  double tau_slip, x_stick, period, t_first_exit;
+} fesd_stick_slip_cycle;
+fesd_stick_slip_cycle fesd_stick_slip_reference(void);
+int fesd_stick_slip_exact(double t, double *x);
+int fesd_stick_slip_field(int sys, int mode, double t, const double *x, const double *u, double *f, void *user);
+int fesd_stick_slip_field_jac(int sys, int mode, double t, const double *x, const double *u, double *J, double *Ju,
+                              void *user);
+int fesd_stick_slip_sw(int sys, double t, const double *x, const double *u, double *c, void *user);
+int fesd_stick_slip_sw_jac(int sys, double t, const double *x, const double *u, double *J, double *Ju, void *user);
+
 #endif

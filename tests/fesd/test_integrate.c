@@ -1,0 +1,107 @@
+/* Error-controlled integration (fesd_integrate):
+ *  - tolerance proportionality: the oscillator, sign-c, ocp-dynamics, slide-exit-2d and the
+ *    stick-slip oscillator (exact or semi-analytic references) with Radau IIA s = 3 and Lobatto
+ *    IIIC s = 3 for rtol = atol = 1e-3 .. 1e-12: the global error at T stays below 100 tol and
+ *    does not grow as tol shrinks (problems whose solution the method reproduces exactly stay at
+ *    round-off);
+ *  - a stop condition x = 1/2 on x' in 2 - sign(x), x0 = -1 (x = t - 1/3 after t = 1/3): the
+ *    integration stops at t = 5/6 to 1e-12 with FESD_ROOT, and one in the other direction is
+ *    passed over;
+ *  - the event log holds every event of the integration. */
+#include <math.h>
+#include <stdio.h>
+
+#include "fesd.h"
+#include "problems/problems.h"
+#include "../check.h"
+
+static int root_x(double t, const double *x, const double *u, double *r, void *user) {
+  (void)t, (void)u, (void)user;
+  r[0] = x[0] - 0.5;  /* increasing through 0 at t = 5/6 */
+  r[1] = x[0] + 0.25; /* increasing at t = 1/4: passed over with direction -1 */
+  return 0;
+}
+
+int main(void) {
+  int fails = 0;
+  const char *probs[5] = {"oscillator", "sign-c", "ocp-dynamics", "slide-exit-2d", "stick-slip"};
+  const fesd_rk_family fams[2] = {FESD_RK_RADAU_IIA, FESD_RK_LOBATTO_IIIC};
+  for (int f = 0; f < 2; f++)
+    for (int p = 0; p < 5; p++) {
+      fesd_problem P;
+      fesd_problem_get(probs[p], &P);
+      double xe[8], prev = INFINITY, worst_ratio = 0;
+      P.exact(P.T, xe);
+      int steps_first = 0, steps_last = 0;
+      for (int e = 3; e <= 12; e++) {
+        const double tol = pow(10.0, -e);
+        fesd_settings set;
+        fesd_settings_default(&set);
+        set.family = fams[f];
+        set.stages = 3;
+        fesd_integrator *it;
+        fesd_create(&it, &P.model, &set);
+        fesd_set_state(it, 0, P.x0, P.u);
+        fesd_tolerances tl;
+        fesd_tolerances_default(&tl);
+        tl.rtol = tl.atol = tol;
+        fesd_set_tolerances(it, &tl);
+        fesd_integrate_info info;
+        int st = fesd_integrate(it, P.u, P.T, &info);
+        double x[8], err = 0;
+        fesd_get_state(it, NULL, x);
+        for (int i = 0; i < P.model.nx; i++) err = fmax(err, fabs(x[i] - xe[i]) / fmax(1.0, fabs(xe[i])));
+        FESD_TEST_CHECK(st == FESD_OK && err <= 100 * tol, "%s %s tol %.0e: %s, error %.2e", probs[p],
+                        fesd_rk_family_name(fams[f]), tol, fesd_status_name(st), err);
+        FESD_TEST_CHECK(err <= 2 * prev || err <= 1e-13, "%s %s tol %.0e: error %.2e grew from %.2e", probs[p],
+                        fesd_rk_family_name(fams[f]), tol, err, prev);
+        prev = err;
+        worst_ratio = fmax(worst_ratio, err / tol);
+        if (e == 3) steps_first = info.steps;
+        steps_last = info.steps;
+        fesd_free(&it);
+      }
+      printf("%-9s s=3 %-14s tol 1e-3 .. 1e-12: max error / tol %.2g, steps %d .. %d\n", fesd_rk_family_name(fams[f]),
+             probs[p], worst_ratio, steps_first, steps_last);
+    }
+  /* stop conditions */
+  {
+    fesd_problem P;
+    fesd_problem_get("sign-a", &P);
+    const int dir[2] = {+1, -1};
+    P.model.n_roots = 2;
+    P.model.roots = root_x;
+    P.model.root_dir = dir;
+    fesd_settings set;
+    fesd_settings_default(&set);
+    fesd_integrator *it;
+    int st = fesd_create(&it, &P.model, &set);
+    fesd_set_state(it, 0, P.x0, NULL);
+    fesd_integrate_info info;
+    st = fesd_integrate(it, NULL, 1.0, &info);
+    double t, x[2];
+    fesd_get_state(it, &t, x);
+    FESD_TEST_CHECK(st == FESD_ROOT && info.root == 0 && fabs(t - 5.0 / 6) <= 1e-12 && fabs(x[0] - 0.5) <= 1e-12,
+                    "stop condition: %s, root %d at t = %.15f (exact 5/6), x = %.15f", fesd_status_name(st), info.root,
+                    t, x[0]);
+    const double t_root = t;
+    st = fesd_integrate(it, NULL, 1.0, &info); /* continues from the root to t = 1 */
+    fesd_get_state(it, &t, x);
+    FESD_TEST_CHECK(st == FESD_OK && t == 1.0 && fabs(x[0] - 2.0 / 3) <= 1e-12, "after the root: %s, t %.3g x %.15f",
+                    fesd_status_name(st), t, x[0]);
+    const fesd_event *ev;
+    int ne, crossing = 0, roots = 0;
+    fesd_event_log(it, &ev, &ne);
+    for (int e = 0; e < ne; e++) {
+      crossing += ev[e].kind == FESD_EVENT_CROSSING && fabs(ev[e].t - 1.0 / 3) <= 1e-12;
+      roots += ev[e].kind == FESD_EVENT_ROOT;
+    }
+    FESD_TEST_CHECK(crossing == 1 && roots == 2, "event log: %d events, crossing at 1/3: %d, roots %d", ne, crossing,
+                    roots);
+    printf("stop condition x = 1/2: at t = %.15f (error %.1e); event log %d events (the crossing, 2 roots)\n", t_root,
+           fabs(t_root - 5.0 / 6), ne);
+    fesd_free(&it);
+  }
+  printf("%d failures\n", fails);
+  return fails != 0;
+}
