@@ -239,7 +239,8 @@ FESD_API int fesd_settings_default(fesd_settings *s);
 
 /**
  * @brief Validate the model and settings, build sign matrices and the step system,
- *        allocate every workspace (the only allocating call besides fesd_trajectory_create).
+ *        allocate the workspaces (steps allocate only for what they meet first: a layout of more
+ *        elements, a sparse pattern the solver has not analysed, longer records, the event log).
  * @return FESD_OK, FESD_ERR_NULL, FESD_ERR_MODEL, FESD_ERR_SIGN_MATRIX, FESD_ERR_DIMENSION,
  *         FESD_ERR_UNSUPPORTED_TABLEAU, FESD_ERR_INVALID_ARG, FESD_ERR_NOMEM.
  */

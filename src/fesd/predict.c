@@ -1,4 +1,4 @@
-/* Switch prediction for the FB fallback path (../shared/notes/solver_prototype.md, S2c):
+/* Switch prediction for the FB fallback path (docs/solver.md, strategy S2c):
  * sign changes of q_i = lambda_i - theta_i along the stage points, refined by linear
  * extrapolation of lambda_i from the side where mode i is inactive; and the re-sorted
  * initial guess around the predicted switches. */

@@ -1,4 +1,4 @@
-/* Reference problems of ../shared/DESIGN.md section 5 (from the FESD paper), with
+/* Reference problems (from the FESD paper: its examples, Sec. 4 and 5), with
  * exact solutions where known. Used by the CLI, the demo, tests and benchmarks;
  * not part of the installed library. */
 #ifndef FESD_PROBLEMS_H
@@ -36,7 +36,7 @@ double fesd_problem_ocp_t1(void);
  * (bisection on the sliding multiplier, composite Simpson for the time). */
 void fesd_problem_slide_exit_point(double *t_exit, double *x2_exit);
 
-/* Stewart-Anitescu problem (DESIGN.md section 5): exact V(x0) = int_0^2 x^2 dt +
+/* Stewart-Anitescu problem (paper Sec. 5.3): exact V(x0) = int_0^2 x^2 dt +
  * (x(2) - 5/3)^2 and dV/dx0; the value and gradient from an integrator created with
  * settings.sensitivities = 1 on the "stewart-anitescu" model (nsim steps over [0, 2]);
  * and a secant shooting on dV/dx0 from x_start. */

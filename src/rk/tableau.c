@@ -18,6 +18,10 @@ const char *fesd_rk_family_name(fesd_rk_family family) {
 
 int fesd_rk_family_parse(const char *name, fesd_rk_family *out) {
   if (!name || !out) return FESD_ERR_NULL;
+  if (strcmp(name, "explicit") == 0) { /* an alias of "erk" */
+    *out = FESD_RK_EXPLICIT;
+    return FESD_OK;
+  }
   for (int f = 0; f < FESD_RK_NUM_FAMILIES; ++f) {
     if (strcmp(name, family_names[f]) == 0) {
       *out = (fesd_rk_family)f;

@@ -1,6 +1,6 @@
 /* Sensitivities dx(T)/dx0 (paper Sec. 2.4 and 4.3, Theorem 5).
  * Oscillator: exact X(T) = expm(A1 (T-1)) J expm(A2), J = I + (f_after - f_before) grad c' /
- * (grad c' f_before) at x(1) = (1,0) (DESIGN.md section 5). FESD converges to it (fitted
+ * (grad c' f_before) at x(1) = (1,0) (paper Prop. 4). FESD converges to it (fitted
  * order >= 1; <= 1e-8 for Radau IIA s = 3 at the finest grid); the standard method does
  * not (error > 1e-2 on fine grids). FESD sensitivities also match central differences of
  * the FESD map itself (1e-6). */

@@ -5,7 +5,7 @@
  *  exit:     x' in -sign(x) + t, x0 = 0 (sign-c): slides until t = 1, x = (t-1)^2/2 after;
  *  oscillator (reference problem): crossing at t = 1 = 4 steps of 1/4 (or 8 of 1/8); state
  *    against the closed form, and dx(T)/dx0 against X(T) = expm(A1 (T-1)) J expm(A2)
- *    (DESIGN.md section 5: the saltation matrix J has to be applied at the step start). */
+ *    (paper Prop. 4: the saltation matrix J has to be applied at the step start). */
 #include "hard_util.h"
 #include "problems/problems.h"
 
