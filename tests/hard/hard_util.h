@@ -111,6 +111,17 @@ static inline double hd_event_time(const hd_run *r, int sys, int kind, double t_
   return NAN;
 }
 
+/* Least-squares slope of -log(e) against log(n) over m points (e > 0): the observed order
+ * when n counts steps. */
+static inline double hd_slope(const double *n, const double *e, int m) {
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  for (int i = 0; i < m; i++) {
+    double a = log(n[i]), b = log(e[i]);
+    sx += a, sy += b, sxx += a * a, sxy += a * b;
+  }
+  return -(m * sxy - sx * sy) / (m * sxx - sx * sx);
+}
+
 #define HD_CHECK FESD_TEST_CHECK
 
 #endif
