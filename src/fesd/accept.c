@@ -214,8 +214,8 @@ static void add_event(fesd_integrator *it, double t, int k, const int *before, i
     e->kind = FESD_EVENT_SLIDING_ENTRY;
   else if (subset(after, na, before, nb)) {
     e->kind = FESD_EVENT_SLIDING_EXIT;
-    /* pinned only by stiffly accurate methods with exit rows (plan.c) */
-    if (!it->set.exit_rows || it->sys.bp) it->step_flags |= FESD_FLAG_EXIT_NOT_PINNED;
+    /* pinned with exit rows on the plan path of the implicit methods (plan.c) */
+    if (!it->exit_pinned) it->step_flags |= FESD_FLAG_EXIT_NOT_PINNED;
   } else
     e->kind = FESD_EVENT_CROSSING;
 }

@@ -180,8 +180,14 @@ int fesd__rows_active(fesd_integrator *it, const unsigned char *act, const int *
       for (int i = 0; i < S->nth; i++)
         it->pair_mode[fesd__pair(S, n, j, i)] =
             act[(size_t)(n * S->s + j) * S->nth + i] ? FESD_NCP_PAIR_B : FESD_NCP_PAIR_A;
+  /* exits: stiffly accurate methods pin the pair of the last stage (the element end);
+   * boundary-point methods the extrapolated theta in the C row (system.h, exit_ext) */
+  fesd__system_set_exits(S, bmode, exit_mode);
   for (int k = 1; k < S->N; k++)
-    if (bmode && bmode[k] == 2) it->pair_mode[fesd__pair(S, k - 1, S->s - 1, exit_mode[k])] = FESD_NCP_PAIR_PIN;
+    if (bmode && bmode[k] == 2) {
+      if (S->bp) it->eq_active[fesd__rowC(S, k)] = 1;
+      else it->pair_mode[fesd__pair(S, k - 1, S->s - 1, exit_mode[k])] = FESD_NCP_PAIR_PIN;
+    }
   int st = fesd__set_border(it);
   return st ? st : fesd_ncp_set_rows(it->ncp, it->eq_active, it->pair_mode);
 }

@@ -221,8 +221,9 @@ static int empty_set(const fesd_integrator *it, const unsigned char *a, int k) {
   return 1;
 }
 
-/* Exits are pinned only by stiffly accurate methods with exit rows (otherwise the FB path). */
-static int can_pin_exit(const fesd_integrator *it) { return it->set.exit_rows && !it->sys.bp; }
+/* Exits are pinned with exit rows by the implicit methods (stiffly accurate: the last stage's
+ * pair; Gauss-Legendre: theta extrapolated to the element end); otherwise the FB path. */
+static int can_pin_exit(const fesd_integrator *it) { return it->set.exit_rows && !it->tab.is_explicit; }
 
 /* A switch at the step start: the start set of k changes (the saltation of the sensitivities
  * is applied explicitly, accept.c). */
@@ -290,17 +291,29 @@ static int update_one(fesd_integrator *it, const double *z, const fesd__violatio
     start_jump(it, k, ns);
     return 1;
   }
+  /* An exit whose sign change brackets a switch of another subsystem: at a corner the other
+   * subsystem's switch makes theta jump (design of a sliding mode that cannot continue past
+   * the second surface), so the mode leaves at that switch, not pinned where theta would
+   * reach zero continuously. (If it should stay, its lambda turns negative right after and
+   * the "first" rule puts it back.) */
+  double t_new = v->t;
+  int jump = 0;
+  if (!v->enter)
+    for (int q = 0; q < it->n_plan; q++) {
+      const fesd__switch *o = &it->plan[q];
+      if (o->sys != k && !o->exit && o->t >= v->lo && o->t < v->hi) t_new = o->t, jump = 1;
+    }
   if (it->n_plan >= it->cap_plan) return FESD_ERR_TOO_MANY_SWITCHES;
   fesd__switch *w = &it->plan[it->n_plan];
-  w->t = v->t;
+  w->t = t_new;
   w->sys = k;
   w->mode = v->mode;
-  w->exit = !v->enter;
+  w->exit = !v->enter && !jump;
   w->kb = -1;
   w->tries = 0;
   w->fresh = 1;
-  w->lo = v->lo;
-  w->hi = v->hi;
+  w->lo = jump ? 0.0 : v->lo; /* a jump moves with the switch it joins */
+  w->hi = jump ? T : v->hi;
   memcpy(after(it, it->n_plan) + a, ns + a, (size_t)(b - a));
   it->n_plan++;
   return 1;

@@ -55,6 +55,7 @@ static int rows_select(fesd_integrator *it, const int *switch_at) {
     it->bmode[k] = sw != 0;
   }
   memset(it->pair_mode, FESD_NCP_PAIR_FB, (size_t)S->n_pair);
+  fesd__system_set_exits(S, NULL, NULL);
   int st = fesd__set_border(it);
   return st ? st : fesd_ncp_set_rows(it->ncp, it->eq_active, it->pair_mode);
 }
@@ -228,6 +229,25 @@ static int fixed_solve(fesd_integrator *it, double *z, int max_iter, fesd_step_i
   int st = fesd__rows_active(it, it->act, it->bmode, it->exit_mode);
   if (st) return st;
   st = solve(it, z, 0.0, it->set.newton_tol, max_iter, 0, info);
+  if (st && getenv("FESD_DEBUG3")) {
+    fesd__system *S = &it->sys;
+    double *raw = malloc(S->n_raw * sizeof(double));
+    fesd__system_eval(z, raw, NULL, S);
+    for (int pass = 0; pass < 6; pass++) {
+      int best = -1;
+      for (int r = 0; r < S->n_eq; r++) if (it->eq_active[r] && (best < 0 || fabs(raw[r]) > fabs(raw[best]))) best = r;
+      if (best < 0) break;
+      const char *ty = "?"; int n = -1;
+      for (int q = 0; q < S->N; q++) { if (best >= S->rel[q] && best < S->rel[q] + S->s * S->rs) { ty = "stage"; n = q; int o = (best - S->rel[q]) % S->rs; ty = o < S->nx ? "V" : o < S->nx + S->nth ? "G" : "S"; }
+        if (S->lbo[q] >= 0 && best >= S->rlb[q] && best < S->rlb[q] + S->nth + S->nsys) ty = "LB", n = q;
+        if (best >= S->rx[q] && best < S->rx[q] + S->nx) ty = "X", n = q; }
+      if (best >= S->rH0 && best < S->rC0) ty = "H"; else if (best >= S->rC0 && best < S->rT) ty = "C"; else if (best == S->rT) ty = "T";
+      fprintf(stderr, "    row %d %s el %d raw %.3e w %.3e\n", best, ty, n, raw[best], S->wraw[best]);
+      raw[best] = 0;
+    }
+    for (int n = 0; n < S->N; n++) fprintf(stderr, "    h[%d]=%.6e lo %.3e hi %.3e\n", n, z[S->ho[n]], it->lb[S->ho[n]], it->ub[S->ho[n]]);
+    free(raw);
+  }
   if (st) return st;
   for (int n = 0; n < it->sys.N; n++)
     if (!(z[it->sys.ho[n]] > 0)) return FESD_ERR_STEP_FAILED;
@@ -505,6 +525,7 @@ static int try_step(fesd_integrator *it, const double *u, double *T, fesd_step_i
   it->nonunique = nonunique;
   st = it->set.method == FESD_METHOD_FESD ? plan_path(it, T, info) : std_path(it, info);
   if (hard_failure(st)) return st;
+  const int st_path_plan = st == FESD_OK;
   if (st != FESD_OK) {
     info->failed_path = it->set.method == FESD_METHOD_FESD ? "plan" : "standard";
     info->failed_residual = info->residual;
@@ -520,6 +541,9 @@ static int try_step(fesd_integrator *it, const double *u, double *T, fesd_step_i
     }
     info->fallback++;
   }
+  /* Gauss-Legendre pins exits only on the plan path (exit_ext); the stiffly accurate methods'
+   * last stage is the element end on either path */
+  it->exit_pinned = it->set.exit_rows && !it->tab.is_explicit && (!S->bp || st_path_plan);
   double ccm = 0;
   if (it->set.method == FESD_METHOD_FESD && info->fallback && (st = fesd__verify(it, it->z, &ccm)))
     return st;

@@ -1,5 +1,6 @@
 #include "fesd/system.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -24,6 +25,12 @@ void fesd__system_free(fesd__system *S) {
   free(S->Juth);
   free(S->lam00_dp);
   free(S->tmp);
+  free(S->exit_ext);
+  free(S->LK);
+  free(S->dgl);
+  free(S->dgul);
+  free(S->xs);
+  fesd__point_free(&S->pl);
   free(S->wraw);
   free(S->wG);
   double *mags[] = {S->magX, S->magV, S->magG, S->refX, S->refV, S->refG};
@@ -62,6 +69,11 @@ double fesd__cross_value(const fesd__system *S, const double *z, int n) {
     c += S->wth[i] * (Th * Lt - diag);
   }
   return c;
+}
+
+void fesd__system_set_exits(fesd__system *S, const int *bmode, const int *exit_mode) {
+  for (int k = 0; k <= S->N; k++)
+    S->exit_ext[k] = S->bp && bmode && k > 0 && k < S->N && bmode[k] == 2 ? exit_mode[k] : -1;
 }
 
 /* ---- Jacobian emission: one traversal counts the entries, writes the pattern, or writes
@@ -128,11 +140,12 @@ static inline __attribute__((always_inline)) void emit_body(const fesd__system *
           EMIT(E, rV + m->rows[k][r], fesd__th(S, n, j) + i, -pe->F[m->Foff[i] + r]);
       }
       /* G rows: g(X) - lambda - mu e */
+      const int lk = S->look && j == 0; /* look-ahead stage: + kappa h grad g . v_1 */
       for (int l = 0; l < s; l++) {
-        const double a = S->tab.A[j][l];
+        const double a = S->tab.A[j][l] + (lk && l == 0 ? S->kappa : 0.0);
         EMIT_DG(E, rG, fesd__v(S, n, l), pe->dgdx, h * a);
       }
-      if (n > 0) EMIT_DG(E, rG, S->xo[n - 1], pe->dgdx, 1.0);
+      if (n > 0) EMIT_DG(E, rG, S->xo[n - 1], lk ? S->dgl + (size_t)n * m->ndg : pe->dgdx, 1.0);
       for (int i = 0; i < nth; i++) {
         EMIT(E, rG + i, S->ho[n], S->KG[(size_t)p * nth + i]); /* d/dh: grad g_i . K_j */
         EMIT(E, rG + i, fesd__la(S, n, j) + i, -1.0);
@@ -170,7 +183,7 @@ static inline __attribute__((always_inline)) void emit_body(const fesd__system *
   for (int k = 1; k < N; k++) {
     EMIT(E, fesd__rowH(S, k), S->ho[k], 1.0);
     EMIT(E, fesd__rowH(S, k), S->ho[k - 1], -1.0);
-    const int rC = fesd__rowC(S, k);
+    const int rC = fesd__rowC(S, k), ex = values ? S->exit_ext[k] : -1, cc = ex < 0;
     for (int n = k - 1; n <= k; n++) {
       const double *L = values ? fesd__left_lambda(S, z, n) : NULL;
       const double *R = (S->bp && S->lbo[n] >= 0 && values) ? z + S->lbo[n] : NULL;
@@ -183,9 +196,10 @@ static inline __attribute__((always_inline)) void emit_body(const fesd__system *
             Lt += z[fesd__la(S, n, j) + i];
           }
         }
-        const double w = values ? wth[i] : 0;
+        const double w = values && cc ? wth[i] : 0; /* an exit row: only its theta entries */
+        const int exr = !cc && n == k - 1 && i == ex;
         for (int j = 0; j < s; j++) {
-          EMIT(E, rC, fesd__th(S, n, j) + i, w * (Lt - z[fesd__la(S, n, j) + i]));
+          EMIT(E, rC, fesd__th(S, n, j) + i, exr ? S->ext[j] : w * (Lt - z[fesd__la(S, n, j) + i]));
           EMIT(E, rC, fesd__la(S, n, j) + i, w * (Th - z[fesd__th(S, n, j) + i]));
         }
         if (n > 0) {
@@ -248,6 +262,15 @@ int fesd__system_init(fesd__system *S, fesd__model *m, const fesd_tableau *tab, 
   S->nsys = m->nsys;
   S->nu = m->nu;
   S->bp = !tab->stiffly_accurate;
+  S->look = !tab->is_explicit && tab->s >= 2;
+  for (int l = 0; l < tab->s; l++) S->look = S->look && tab->A[0][l] == 0.0;
+  S->kappa = S->look ? tab->c[1] : 0.0;
+  for (int j = 0; j < tab->s; j++) { /* l_j(1) */
+    double l = 1.0;
+    for (int q = 0; q < tab->s; q++)
+      if (q != j) l *= (1.0 - tab->c[q]) / (tab->c[j] - tab->c[q]);
+    S->ext[j] = l;
+  }
   const int s = S->s, nx = S->nx, nth = S->nth, nsys = S->nsys, nu = S->nu, N = N_cap;
   S->sb = nx + 2 * nth + nsys;
   S->rs = nx + nth + nsys;
@@ -268,11 +291,13 @@ int fesd__system_init(fesd__system *S, fesd__model *m, const fesd_tableau *tab, 
   S->magG = calloc((size_t)nsys, sizeof(double));
   S->refG = calloc((size_t)nsys, sizeof(double));
   S->wth = malloc((size_t)nth * sizeof(double));
-  if (!S->el || !S->xo || !S->ho || !S->lbo || !S->rel || !S->rlb || !S->rx || !S->wG || !S->wth ||
+  S->exit_ext = malloc((size_t)(N + 1) * sizeof(int));
+  if (!S->exit_ext || !S->el || !S->xo || !S->ho || !S->lbo || !S->rel || !S->rlb || !S->rx || !S->wG || !S->wth ||
       !S->magX || !S->magV || !S->refX || !S->refV || !S->magG || !S->refG)
     goto nomem;
   for (int k = 0; k < nsys; k++) S->wG[k] = 1.0;
   for (int i = 0; i < nth; i++) S->wth[i] = 1.0;
+  for (int k = 0; k <= N; k++) S->exit_ext[k] = -1;
   int off = 0, row = 0;
   for (int n = 0; n < N; n++) {
     S->el[n] = off;
@@ -308,6 +333,13 @@ int fesd__system_init(fesd__system *S, fesd__model *m, const fesd_tableau *tab, 
     goto nomem;
   for (int p = 0; p < np; p++)
     if (fesd__point_alloc(m, &S->pe[p], p < N * s)) goto nomem;
+  if (S->look) {
+    S->LK = malloc((size_t)N * nth * sizeof(double));
+    S->dgl = malloc((size_t)N * (m->ndg > 0 ? m->ndg : 1) * sizeof(double));
+    S->dgul = malloc((size_t)N * nth * nu1 * sizeof(double));
+    S->xs = malloc((size_t)nx * sizeof(double));
+    if (!S->LK || !S->dgl || !S->dgul || !S->xs || fesd__point_alloc(m, &S->pl, 0)) goto nomem;
+  }
   fesd__system_set_N(S, N_cap);
   S->wraw = malloc((size_t)S->n_raw * sizeof(double));
   if (!S->wraw) goto nomem;
@@ -316,6 +348,46 @@ int fesd__system_init(fesd__system *S, fesd__model *m, const fesd_tableau *tab, 
 nomem:
   fesd__system_free(S);
   return FESD_ERR_NOMEM;
+}
+
+/* Look-ahead term of element n's first stage (X = x_n, pe evaluated there with grad g):
+ * LK = kappa h grad g . v_1; with want_jac also its derivatives: d/dh (KG), d/dx_n = grad g +
+ * kappa h H v_1 (dgl; H v_1 by a forward difference of the switch Jacobian along v_1, exact
+ * for affine switching functions) and, with sensitivities, d/du (dgul). */
+static int look_ahead(fesd__system *S, const double *z, int n, double tn, const fesd__point_eval *pe,
+                      int want_jac) {
+  fesd__model *m = S->model;
+  const int nx = S->nx, nth = S->nth, nu = S->nu, ndg = m->ndg;
+  const double h = z[S->ho[n]], kh = S->kappa * h, *v1 = z + fesd__v(S, n, 0);
+  const double *X = S->X + (size_t)n * S->s * nx;
+  for (int i = 0; i < nth; i++) {
+    const double d = fesd__dg_dot(m, pe, i, v1);
+    S->LK[(size_t)n * nth + i] = kh * d;
+    if (want_jac) S->KG[(size_t)n * S->s * nth + i] = S->kappa * d;
+  }
+  if (!want_jac) return FESD_OK;
+  double *dgl = S->dgl + (size_t)n * ndg, *dgul = S->dgul + (size_t)n * nth * nu;
+  const int want_u = S->want_u && nu > 0;
+  memcpy(dgl, pe->dgdx, (size_t)ndg * sizeof(double));
+  if (want_u) memcpy(dgul, pe->dgdu, (size_t)nth * nu * sizeof(double));
+  double vn = 0, xn = 0;
+  for (int r = 0; r < nx; r++) {
+    vn = fmax(vn, fabs(v1[r]));
+    xn = fmax(xn, fabs(X[r]));
+  }
+  if (vn == 0.0 || kh == 0.0) return FESD_OK;
+  const double delta = 1.5e-8 * fmax(xn, 1e-300) / vn; /* relative step along v_1 */
+  for (int r = 0; r < nx; r++) S->xs[r] = X[r] + delta * v1[r];
+  fesd__point_eval q = S->pl;
+  q.g = NULL;
+  if (!want_u) q.dgdu = NULL;
+  int st = fesd__model_eval(m, tn, S->xs, S->u, &q);
+  if (st) return st;
+  const double sc = kh / delta;
+  for (int e = 0; e < ndg; e++) dgl[e] += sc * (q.dgdx[e] - pe->dgdx[e]);
+  if (want_u)
+    for (int e = 0; e < nth * nu; e++) dgul[e] += sc * (q.dgdu[e] - pe->dgdu[e]);
+  return FESD_OK;
 }
 
 /* Evaluate the model at every stage point (and boundary point) of z. */
@@ -337,16 +409,20 @@ int fesd__system_points(fesd__system *S, const double *z, int want_jac) {
         X[r] = xn[r] + h * acc;
       }
       fesd__point_eval pe = S->pe[p];
-      if (!want_jac) pe.dFdx = pe.dgdx = NULL;
+      const int lk = S->look && j == 0; /* needs grad g for its value */
+      if (!want_jac) pe.dFdx = NULL;
+      if (!want_jac && !lk) pe.dgdx = NULL;
       if (!(want_jac && S->want_u)) pe.dFdu = pe.dgdu = NULL;
       int st = fesd__model_eval(m, tn + S->tab.c[j] * h, X, S->u, &pe);
       if (st) return st;
+      if (lk && (st = look_ahead(S, z, n, tn, &pe, want_jac))) return st;
       if (want_jac) {
         const double *th = z + fesd__th(S, n, j);
         double *J = S->Jth + (size_t)p * m->pf_nnz;
         fesd__Jth(m, &pe, th, J);
         fesd__pf_mv(m, J, K, S->JK + (size_t)p * nx);
-        for (int i = 0; i < nth; i++) S->KG[(size_t)p * nth + i] = fesd__dg_dot(m, &pe, i, K);
+        if (!lk)
+          for (int i = 0; i < nth; i++) S->KG[(size_t)p * nth + i] = fesd__dg_dot(m, &pe, i, K);
         if (S->want_u && nu > 0) {
           double *Ju = S->Juth + (size_t)p * nx * nu;
           memset(Ju, 0, (size_t)nx * nu * sizeof(double));
@@ -393,6 +469,8 @@ int fesd__system_eval(const double *z, double *raw, double *jac, void *ctx) {
       for (int i = 0; i < nth; i++)
         if (th[i] != 0.0) fesd__F_axpy(m, pe, i, -th[i], raw + rV);
       for (int i = 0; i < nth; i++) raw[rG + i] = pe->g[i] - la[i] - mu[m->sys_of[i]];
+      if (S->look && j == 0)
+        for (int i = 0; i < nth; i++) raw[rG + i] += S->LK[(size_t)n * nth + i];
       for (int k = 0; k < nsys; k++) raw[rS + k] = 1.0;
       for (int i = 0; i < nth; i++) raw[rS + m->sys_of[i]] -= th[i];
     }
@@ -415,7 +493,14 @@ int fesd__system_eval(const double *z, double *raw, double *jac, void *ctx) {
   for (int n = 0; n < N; n++) hs += z[S->ho[n]];
   for (int k = 1; k < N; k++) {
     raw[fesd__rowH(S, k)] = z[S->ho[k]] - z[S->ho[k - 1]];
-    raw[fesd__rowC(S, k)] = fesd__cross_value(S, z, k - 1) + fesd__cross_value(S, z, k);
+    const int ex = S->exit_ext[k];
+    if (ex >= 0) {
+      double e = 0;
+      for (int j = 0; j < s; j++) e += S->ext[j] * z[fesd__th(S, k - 1, j) + ex];
+      raw[fesd__rowC(S, k)] = e;
+    } else {
+      raw[fesd__rowC(S, k)] = fesd__cross_value(S, z, k - 1) + fesd__cross_value(S, z, k);
+    }
   }
   raw[S->rT] = hs - S->T;
   for (int n = 0; n < N; n++)
@@ -440,13 +525,14 @@ int fesd__system_param_jac(fesd__system *S, const double *z, double *out) {
     const double *J = S->Jth + (size_t)j * m->pf_nnz;
     const fesd__point_eval *pe = &S->pe[j];
     const int rV = S->rel[0] + j * S->rs, rG = rV + nx;
+    const double *dg = S->look && j == 0 ? S->dgl : pe->dgdx; /* element 0's look-ahead block */
     for (int q = 0; q < m->pf_nnz; q++)
       out[(size_t)m->pf_c[q] * ld + rV + m->pf_r[q]] -= J[q];
     for (int k = 0; k < m->nsys; k++)
       for (int cp = 0; cp < m->ncol[k]; cp++)
         for (int li = 0; li < m->nf[k]; li++)
           out[(size_t)m->cols[k][cp] * ld + rG + m->th_off[k] + li] +=
-              pe->dgdx[m->dgoff[k] + (size_t)cp * m->nf[k] + li];
+              dg[m->dgoff[k] + (size_t)cp * m->nf[k] + li];
   }
   for (int r = 0; r < nx; r++) out[(size_t)r * ld + S->rx[0] + r] = -1.0;
   /* u: every stage point and boundary point */
@@ -457,9 +543,10 @@ int fesd__system_param_jac(fesd__system *S, const double *z, double *out) {
         const double *Ju = S->Juth + (size_t)p * nx * nu;
         const fesd__point_eval *pe = &S->pe[p];
         const int rV = S->rel[n] + j * S->rs, rG = rV + nx;
+        const double *dgu = S->look && j == 0 ? S->dgul + (size_t)n * nth * nu : pe->dgdu;
         for (int c = 0; c < nu; c++) {
           for (int r = 0; r < nx; r++) out[(size_t)(nx + c) * ld + rV + r] = -Ju[c * nx + r];
-          for (int i = 0; i < nth; i++) out[(size_t)(nx + c) * ld + rG + i] = pe->dgdu[c * nth + i];
+          for (int i = 0; i < nth; i++) out[(size_t)(nx + c) * ld + rG + i] = dgu[c * nth + i];
         }
       }
       if (S->lbo[n] >= 0) {
@@ -471,7 +558,7 @@ int fesd__system_param_jac(fesd__system *S, const double *z, double *out) {
     }
   }
   /* lambda00 enters C(1) through element 0: d/dlam00_i = Theta_{0,i}. */
-  if (N > 1) {
+  if (N > 1 && S->exit_ext[1] < 0) {
     const int rC = fesd__rowC(S, 1);
     for (int i = 0; i < nth; i++) {
       double Th = 0;

@@ -61,6 +61,25 @@ typedef struct {
   /* row weights (n_raw of the largest layout), indicator weights per subsystem (wG) and
    * per stacked mode (wth = wG of its subsystem) */
   double *wraw, *wG, *wth;
+  /* Look-ahead first stage (methods whose first stage is the element start with no stage
+   * derivative in it: Lobatto IIIA). Its indicator rows compare g(x_n) + kappa h grad g(x_n).v_1
+   * (the indicators a little way along the stage derivative) instead of g(x_n): on a sliding
+   * surface this is the tangency condition that fixes theta_1, which the collocation
+   * conditions leave free (x_n itself is already on the surface), and at a switch it picks
+   * the mode that continues. Per element: the term (nth), its x_n-Jacobian block grad g +
+   * kappa h (Hessian v_1) (ndg, the Hessian product by differences of the switch
+   * Jacobian) and, with sensitivities, the u-block (nth x nu). */
+  int look;
+  double kappa;
+  /* Pinned sliding exits of methods whose last stage is not the element end (Gauss-Legendre):
+   * at boundary k with exit_ext[k] = i >= 0 the row C(k) holds theta_i of element k-1
+   * extrapolated to the element end (sum_j ext[j] theta_{k-1,j,i} = 0, ext[j] = l_j(1) of the
+   * Lagrange basis on the nodes c) instead of the cross complementarity (which is zero for
+   * every boundary time at an exit). */
+  int *exit_ext;
+  double ext[FESD_RK_MAX_STAGES];
+  double *LK, *dgl, *dgul, *xs;
+  fesd__point_eval pl;  /* scratch: switch Jacobians at x_n + delta v_1 */
   /* sizes at the last weighting (per state component: X rows, V rows; per subsystem: the
    * indicators), and their maxima over the accepted steps (weights.c) */
   double *magX, *magV, *magG, *refX, *refV, *refG;
@@ -113,6 +132,10 @@ int fesd__system_eval(const double *z, double *raw, double *jac, void *ctx);
 /* Raw-row derivatives w.r.t. (x_start, u) at z (after an eval with want_u set):
  * out is n_raw x (nx + nu), column-major, zeroed here. */
 int fesd__system_param_jac(fesd__system *S, const double *z, double *out);
+
+/* Exit rows of the current layout: boundary k pins the exit of mode exit_mode[k] when
+ * bmode[k] == 2 and the method has boundary points (see exit_ext); bmode NULL: none. */
+void fesd__system_set_exits(fesd__system *S, const int *bmode, const int *exit_mode);
 
 /* Compact cross-complementarity value of element n at z. */
 double fesd__cross_value(const fesd__system *S, const double *z, int n);

@@ -126,10 +126,14 @@ static void scan_signs(fesd_integrator *it, const double *z, const unsigned char
     int aprev = act[i];
     v0 = act[i] ? (it->have_prev_theta ? it->theta_prev[i] : 1.0) : it->lam00[i] * S->wth[i];
     double tn = 0;
-    int done = 0;
+    int done = 0, kept = 0;
     for (int n = 0; n < S->N && !done; n++) {
       const double h = z[S->ho[n]];
-      if (set_changes(it, act, n, k)) t_change = tn;
+      if (set_changes(it, act, n, k)) {
+        t_change = tn;
+        /* the mode stays active across the change (its subsystem entered a sliding mode) */
+        kept = act[(size_t)(n * s - 1) * nth + i] && act[(size_t)(n * s) * nth + i];
+      }
       for (int j = 0; j <= s; j++) {
         double t, val;
         const int a = act[(size_t)(n * s + (j < s ? j : s - 1)) * nth + i];
@@ -144,9 +148,17 @@ static void scan_signs(fesd_integrator *it, const double *z, const unsigned char
           t = tn + S->tab.c[j] * h;
           val = a ? z[fesd__th(S, n, j) + i] : z[fesd__la(S, n, j) + i] * S->wth[i];
         } else {
-          if (!S->bp || a) continue; /* boundary LP point: lambda of inactive modes */
+          if (!S->bp) continue;
+          /* element end of a boundary-point method: lambda (boundary LP) of inactive modes,
+           * theta extrapolated from the stages of active ones (an exit after the last stage) */
           t = tn + h;
-          val = z[S->lbo[n] + i] * S->wth[i];
+          if (a) {
+            if (S->tab.is_explicit) continue;
+            val = 0;
+            for (int l = 0; l < s; l++) val += S->ext[l] * z[fesd__th(S, n, l) + i];
+          } else {
+            val = z[S->lbo[n] + i] * S->wth[i];
+          }
         }
         if (val < -tol) {
           fesd__violation c = {0};
@@ -159,7 +171,9 @@ static void scan_signs(fesd_integrator *it, const double *z, const unsigned char
           c.enter = !a;
           c.element = n;
           c.stage = n * s + (j < s ? j : s); /* j == s: the element-end LP point */
-          c.first = isnan(v0) || c.t <= t_change + t_eps;
+          /* a mode kept through a sliding entry whose theta is negative at the first point
+           * after it: the entry should have been a crossing (a corner) */
+          c.first = isnan(v0) || c.t <= t_change + t_eps || (kept && a && t0 <= t_change + t_eps);
           c.filippov = 0;
           note(&ps[k], &c);
           done = 1;

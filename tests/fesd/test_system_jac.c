@@ -18,7 +18,9 @@ static double urand(void) {
   return (double)(rng >> 11) / 9007199254740992.0;
 }
 
-static int check(const char *prob, fesd_rk_family fam, int s, int N) {
+/* exit: pin a sliding exit of mode 0 at boundary 1 (boundary-point methods: the extrapolated
+ * theta row) */
+static int check(const char *prob, fesd_rk_family fam, int s, int N, int exit) {
   fesd_problem P;
   fesd_problem_get(prob, &P);
   fesd__model M;
@@ -30,6 +32,9 @@ static int check(const char *prob, fesd_rk_family fam, int s, int N) {
     return 1;
   }
   fesd__system_set_N(&S, N);
+  int bmode[8] = {0}, exit_mode[8] = {0};
+  bmode[1] = exit ? 2 : 0;
+  fesd__system_set_exits(&S, bmode, exit_mode);
   for (int r = 0; r < S.n_raw; r++) S.wraw[r] = 0.5 + urand();
   for (int k = 0; k < S.nsys; k++) S.wG[k] = 0.2 + 2 * urand();
   for (int i = 0; i < S.nth; i++) S.wth[i] = S.wG[M.sys_of[i]];
@@ -81,8 +86,8 @@ static int check(const char *prob, fesd_rk_family fam, int s, int N) {
     }
   }
   int fail = worst > 1e-6 || worstp > 1e-6;
-  printf("%s %-12s %-9s s=%d N=%d n=%4d nnz=%5d: max rel err jac %.2e, param jac %.2e\n",
-         fail ? "FAIL" : "ok  ", prob, fesd_rk_family_name(fam), s, N, n, S.nnz, worst, worstp);
+  printf("%s %-13s %-9s s=%d N=%d%s n=%4d nnz=%5d: max rel err jac %.2e, param jac %.2e\n",
+         fail ? "FAIL" : "ok  ", prob, fesd_rk_family_name(fam), s, N, exit ? " exit" : "", n, S.nnz, worst, worstp);
   free(z), free(zp), free(raw), free(r1), free(r2), free(jac), free(J), free(dp), free(prow), free(pcol);
   fesd__system_free(&S);
   fesd__model_free(&M);
@@ -91,14 +96,21 @@ static int check(const char *prob, fesd_rk_family fam, int s, int N) {
 
 int main(void) {
   int fails = 0;
-  fails += check("oscillator", FESD_RK_RADAU_IIA, 2, 2);
-  fails += check("oscillator", FESD_RK_RADAU_IIA, 3, 3);
-  fails += check("oscillator", FESD_RK_GAUSS_LEGENDRE, 2, 3);
-  fails += check("oscillator", FESD_RK_LOBATTO_IIIC, 3, 2);
-  fails += check("oscillator", FESD_RK_EXPLICIT, 4, 2);
-  fails += check("sign-c", FESD_RK_RADAU_IIA, 2, 2);
-  fails += check("ocp-dynamics", FESD_RK_RADAU_IIA, 2, 3);
-  fails += check("ocp-dynamics", FESD_RK_GAUSS_LEGENDRE, 1, 2);
+  fails += check("oscillator", FESD_RK_RADAU_IIA, 2, 2, 0);
+  fails += check("oscillator", FESD_RK_RADAU_IIA, 3, 3, 0);
+  fails += check("oscillator", FESD_RK_GAUSS_LEGENDRE, 2, 3, 0);
+  fails += check("oscillator", FESD_RK_GAUSS_LEGENDRE, 3, 3, 1);
+  fails += check("oscillator", FESD_RK_LOBATTO_IIIC, 3, 2, 0);
+  fails += check("oscillator", FESD_RK_LOBATTO_IIIA, 3, 3, 0);
+  fails += check("oscillator", FESD_RK_EXPLICIT, 4, 2, 0);
+  fails += check("sign-c", FESD_RK_RADAU_IIA, 2, 2, 0);
+  /* curved switching surface: the look-ahead stage's Hessian term (by differences) */
+  fails += check("slide-exit-2d", FESD_RK_LOBATTO_IIIA, 2, 2, 0);
+  fails += check("slide-exit-2d", FESD_RK_LOBATTO_IIIA, 4, 3, 0);
+  fails += check("slide-exit-2d", FESD_RK_GAUSS_LEGENDRE, 2, 2, 1);
+  fails += check("ocp-dynamics", FESD_RK_RADAU_IIA, 2, 3, 0);
+  fails += check("ocp-dynamics", FESD_RK_GAUSS_LEGENDRE, 1, 2, 0);
+  fails += check("ocp-dynamics", FESD_RK_LOBATTO_IIIA, 2, 2, 0);
   printf("%d failures\n", fails);
   return fails != 0;
 }

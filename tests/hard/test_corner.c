@@ -13,7 +13,8 @@
  * unique consistent one kept (sliding: theta from n_k . x' = 0 in (0,1); a mode on its line:
  * x' leaves into its side), asserted unique. Event times are divisions (-c_k / n_k . x').
  * 50 seeded random starts per design whose events are >= 0.02 apart, plus direct hits of the
- * corner from each quadrant; Radau IIA s = 2, 3 and N_sim = 7, 13, 40. Asserted: every run
+ * corner from each quadrant; Radau IIA s = 2, 3 and N_sim = 7, 13, 40 (argument "families": Lobatto
+ * IIIA, Lobatto IIIC and Gauss-Legendre instead). Asserted: every run
  * completes, the state at every element boundary is exact to 1e-12 (relative), the events
  * (time to 1e-12, subsystem, kind) are the reference's. */
 #include "hard_util.h"
@@ -132,8 +133,13 @@ static double urand(void) { /* LCG (Knuth MMIX), uniform in [-1, 1) */
   return (double)(rng >> 11) / 4503599627370496.0 - 1;
 }
 
-int main(void) {
+int main(int argc, char **argv) {
   int fails = 0;
+  /* argument "families": the other implicit families (exact on piecewise-constant fields too) */
+  const fesd_rk_family radau[] = {FESD_RK_RADAU_IIA},
+                       others[] = {FESD_RK_LOBATTO_IIIA, FESD_RK_LOBATTO_IIIC, FESD_RK_GAUSS_LEGENDRE};
+  const int fam_others = argc > 1 && !strcmp(argv[1], "families"), n_fam = fam_others ? 3 : 1;
+  const fesd_rk_family *fams = fam_others ? others : radau;
   static hd_run H;
   static pl_ref R;
   const int nm[2] = {2, 2}, ns[2] = {1, 1}, nsims[3] = {7, 13, 40};
@@ -169,17 +175,19 @@ int main(void) {
         ref_state(&R, R.ev_t[e], xe);
         corner |= hd_maxdiff(xe, (double[2]){0, 0}, 2) < 1e-12;
       }
+      for (int fi = 0; fi < n_fam; fi++)
       for (int s = 2; s <= 3; s++)
         for (int g = 0; g < 3; g++) {
           fesd_settings set;
           fesd_settings_default(&set);
           set.stages = s;
+          set.family = fams[fi];
           int st = hd_integrate(&m, &set, 0, x0, NULL, T, nsims[g], &H);
           runs++, corner_runs += corner;
           if (st) {
             failed++;
-            HD_CHECK(0, "design %s start %d (x0 = %.17g, %.17g) s=%d N_sim=%d: %s at step %d (t = %.6f, path %s)",
-                     D->name, start, x0[0], x0[1], s, nsims[g], fesd_status_name(st), H.steps_done, H.t_end,
+            HD_CHECK(0, "design %s start %d (x0 = %.17g, %.17g) %s s=%d N_sim=%d: %s at step %d (t = %.6f, path %s)",
+                     D->name, start, x0[0], x0[1], fesd_rk_family_name(fams[fi]), s, nsims[g], fesd_status_name(st), H.steps_done, H.t_end,
                      H.info.failed_path ? H.info.failed_path : "-");
             continue;
           }
@@ -198,8 +206,9 @@ int main(void) {
             ev_err = fmax(ev_err, best);
           }
           worst = fmax(worst, err), worst_ev = fmax(worst_ev, ev_err);
-          HD_CHECK(err <= 1e-12 && match, "design %s start %d (x0 = %.17g, %.17g) s=%d N_sim=%d: state err %.1e, "
-                   "%d events (reference %d), matched %d (time err %.1e)", D->name, start, x0[0], x0[1], s, nsims[g],
+          HD_CHECK(err <= 1e-12 && match, "design %s start %d (x0 = %.17g, %.17g) %s s=%d N_sim=%d: state err %.1e, "
+                   "%d events (reference %d), matched %d (time err %.1e)", D->name, start, x0[0], x0[1],
+                   fesd_rk_family_name(fams[fi]), s, nsims[g],
                    err, H.n_ev, R.n_ev, match, ev_err);
         }
     }
