@@ -289,6 +289,7 @@ int fesd_set_state(fesd_integrator *it, double t0, const double *x0, const doubl
   for (int i = 0; i < it->nxu; i++)
     if (!isfinite(x0[i])) return FESD_ERR_INVALID_ARG;
   it->t = t0;
+  it->t_c = 0.0;
   memcpy(it->x, x0, (size_t)it->nxu * sizeof(double));
   if (it->wrap.td) it->x[it->nxu] = t0; /* time as the last state */
   it->have_ws = 0;
@@ -315,6 +316,7 @@ int fesd_set_state(fesd_integrator *it, double t0, const double *x0, const doubl
 void fesd__save(fesd_integrator *it, fesd__saved *b) {
   const size_t nx = (size_t)it->nx, nth = (size_t)it->nth, nu = (size_t)it->nu;
   b->t = it->t;
+  b->t_c = it->t_c;
   b->have_ws = it->have_ws;
   b->have_prev_theta = it->have_prev_theta;
   b->n_el = it->n_el;
@@ -332,6 +334,7 @@ void fesd__save(fesd_integrator *it, fesd__saved *b) {
 void fesd__load(fesd_integrator *it, const fesd__saved *b) {
   const size_t nx = (size_t)it->nx, nth = (size_t)it->nth, nu = (size_t)it->nu;
   it->t = b->t;
+  it->t_c = b->t_c;
   it->have_ws = b->have_ws;
   it->have_prev_theta = b->have_prev_theta;
   it->n_el = b->n_el;
@@ -378,7 +381,11 @@ int fesd_step(fesd_integrator *it, const double *u, double T, fesd_step_info *in
    * or by halving) fails the step: its result would differ from the one of a clean run */
   if (nomem_count(it) != nomem0) st = FESD_ERR_NOMEM;
   if (st == FESD_OK) {
-    it->t = t_start + T; /* sub-steps add up to T up to round-off */
+    /* sub-steps add up to T up to round-off; compensated summation keeps a long run of
+     * steps at the exact sum of the step lengths (a plain sum drifts by ~N eps t) */
+    const double y = T - it->t_c, tt = t_start + y;
+    it->t_c = (tt - t_start) - y;
+    it->t = tt;
     if (it->wrap.td) it->x[it->nxu] = it->t;
   }
   info->time = fesd__wall_time() - t0;

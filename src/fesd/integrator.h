@@ -56,7 +56,7 @@ typedef struct {
  * of a sub-step attempt, restored before halving (a failure inside accept, e.g. a callback
  * at the new state, can leave the state half-updated). */
 typedef struct {
-  double t, *x, *lam, *th, *blk, *Sx, *Su, *ldp;
+  double t, t_c, *x, *lam, *th, *blk, *Sx, *Su, *ldp;
   int have_ws, have_prev_theta, n_el, n_events;
 } fesd__saved;
 
@@ -72,6 +72,7 @@ struct fesd_integrator {
   int n, nx, nu, nth, nsys, s, np;
   /* current state */
   double t;
+  double t_c; /* compensation of the sum of the step lengths (t is their Kahan sum) */
   double *x, *lam00, *theta_prev, *u_cur, *ws_blk; /* ws_blk: last stage block of the last step */
   int have_state, have_ws, have_prev_theta;
   /* step data (sized for N_cap elements) */
