@@ -10,10 +10,22 @@
  * g^k(x,u) in R^{nf_k}. Mode i of subsystem k is active in the region where row i of
  * S^k matches the signs of c^k: with the default full sign matrix, row i has entry
  * S[i][j] = -1 if bit (nc-1-j) of i is set, else +1 (row 0 = all c_j > 0, last row =
- * all c_j < 0).
+ * all c_j < 0). Mode i is the i-th field (field(sys, i, ...)), the i-th row of the sign
+ * matrix and the i-th entry of theta/lambda of that subsystem.
  *
- * Units: t, T, h in the model's time unit; tolerances absolute in the units of
- * the residual rows (states, indicator values).
+ * nosnoc users: nosnoc's S matrix of a subsystem (one row per mode, one column per switching
+ * function, entries +-1, modes in its order of F) is passed unchanged as sign[k] (row-major,
+ * n_modes x n_switch), with field(sys, i, ...) returning nosnoc's i-th column of F.
+ *
+ * Every mode field is evaluated at every stage point, also outside its region (a Runge-Kutta
+ * stage of a sliding or nearly switching element lies on either side of the surface): fields
+ * and switching functions must be defined, finite and smooth across the surfaces (smooth
+ * extensions of each mode's field, not a field that returns an error or jumps outside its
+ * region).
+ *
+ * Units: t, T, h in the model's time unit. Tolerances of the step solver are relative to the
+ * size of the quantities each equation compares (docs/solver.md, "Row weights"); those of
+ * fesd_integrate are rtol/atol on the state (fesd_tolerances).
  */
 #ifndef FESD_INTEGRATOR_H
 #define FESD_INTEGRATOR_H
@@ -43,7 +55,9 @@ typedef int (*fesd_field_jac_fn)(int sys, int mode, double t, const double *x, c
 /** Switching functions c^sys(x,u) (n_switch[sys] values), or indicators g^sys
  *  (n_modes[sys] values) when n_switch[sys] == 0. */
 typedef int (*fesd_switch_fn)(int sys, double t, const double *x, const double *u, double *c, void *user);
-/** Jacobians of the switch callback: dcdx (rows x nx), dcdu (rows x nu; NULL when nu == 0). */
+/** Jacobians of the switch callback: dcdx (rows x nx, column-major like dfdx: entry (r, c) at
+ *  dcdx[c * rows + r]; rows = n_switch[sys], or n_modes[sys] with indicators), dcdu (rows x nu,
+ *  column-major; NULL when nu == 0). */
 typedef int (*fesd_switch_jac_fn)(int sys, double t, const double *x, const double *u, double *dcdx,
                                   double *dcdu, void *user);
 
@@ -193,9 +207,9 @@ typedef struct {
                                      not differentiable there); dx/dx0 and dx/du of this step are
                                      not to be trusted (the state is) */
 #define FESD_FLAG_EXIT_NOT_PINNED 0x4 /**< a sliding exit was placed by a formulation that does
-                                     not pin it (exit_rows = 0, or a family whose last stage is not
-                                     the element end: Gauss-Legendre, explicit RK): its time is only
-                                     O(h) accurate */
+                                     not pin it (exit_rows = 0, explicit RK, or the FB fallback of
+                                     Gauss-Legendre): its time is not determined by the equations
+                                     and does not converge with h (docs/sliding_exit.md) */
 #define FESD_FLAG_COARSE 0x8    /**< the step's local error estimate exceeds its tolerance
                                      (settings.coarse_tol, relative): the step is too long for the
                                      accuracy of the solution */
@@ -255,7 +269,8 @@ FESD_API int fesd_set_state(fesd_integrator *it, double t0, const double *x0, co
 
 /**
  * @brief Advance one integration step of length T with control u (N_FE elements),
- *        warm started from the previous step. On failure the state is unchanged
+ *        warm started from the previous step. info may be NULL (no statistics wanted).
+ *        On failure the state is unchanged
  *        (the caller may retry with other settings). FESD_ERR_NOMEM: an allocation of the
  *        sparse linear solvers (pattern analyses, factorizations) failed during the step,
  *        also when another path could have finished it (its result would differ from the
