@@ -336,7 +336,9 @@ typedef struct {
   int status;           /**< FESD_OK, FESD_ROOT or a negative fesd_status */
   double t;             /**< time reached */
   int steps;            /**< accepted steps */
-  int rejected;         /**< steps rejected by the error test */
+  int switch_steps;     /**< accepted steps that hold at least one event */
+  int events;           /**< events logged (fesd_event_log) */
+  int rejected;         /**< steps rejected by the error test (error-test failures) */
   int failed_attempts;  /**< steps without a solution, retried shorter */
   int newton_iter;      /**< Newton iterations of all attempts */
   int root;             /**< on FESD_ROOT: the stop condition's index (else -1) */
@@ -366,7 +368,9 @@ FESD_API int fesd_integrate(fesd_integrator *it, const double *u, double t_out, 
 FESD_API int fesd_integrate_grid(fesd_integrator *it, const double *u, int n, const double *t_out, double *x_out,
                                  fesd_integrate_info *info);
 /** @brief All events since fesd_set_state that fesd_integrate accepted (pointers valid until
- *         the next integration call or fesd_set_state). */
+ *         the next integration call or fesd_set_state). Stop conditions appear where they
+ *         stopped the integration (zero crossings in their direction); fesd_last_events also
+ *         lists their crossings in the other direction. */
 FESD_API int fesd_event_log(const fesd_integrator *it, const fesd_event **events, int *count);
 
 /** Accumulated statistics since fesd_set_state. */

@@ -6,7 +6,7 @@ cd "$(dirname "$0")/.."
 BUILD_DIR=${1:-build}
 shift || true
 
-PKGS=(build-essential meson ninja-build pkg-config libsuitesparse-dev libopenblas-dev liblapack-dev valgrind)
+PKGS=(build-essential meson ninja-build pkg-config libsuitesparse-dev libopenblas-dev liblapack-dev libmetis-dev valgrind)
 [ "${FESD_SETUP_EXTRA:-}" ] && PKGS+=(${FESD_SETUP_EXTRA})
 missing=()
 for p in "${PKGS[@]}"; do

@@ -88,11 +88,20 @@ static double first_step(fesd_integrator *it, const double *u, double span) {
 }
 
 /* Append the last step's events to the integration's log (grown outside the Newton loop). */
+/* A zero crossing of stop condition ev->sys in its direction (model.root_dir). */
+static int root_wanted(const fesd_integrator *it, const fesd_event *ev) {
+  const int up = ev->n_after == 1 && ev->after[0] == 0; /* into r > 0 */
+  const int dir = it->wrap.user.root_dir ? it->wrap.user.root_dir[ev->sys] : 0;
+  return !((dir > 0 && !up) || (dir < 0 && up));
+}
+
+/* Append the last step's events to the log (stop conditions only where they stop). */
 static int log_events(fesd_integrator *it) {
   const fesd_event *ev;
   int ne;
   fesd_last_events(it, &ev, &ne);
   for (int e = 0; e < ne; e++) {
+    if (ev[e].kind == FESD_EVENT_ROOT && !root_wanted(it, &ev[e])) continue;
     const int need = ev[e].n_before + ev[e].n_after;
     if (it->log_n == it->log_cap || it->log_pool_n + need > it->log_pool_cap) {
       int cap = it->log_cap ? 2 * it->log_cap : 64;
@@ -139,10 +148,7 @@ static int root_crossed(const fesd_integrator *it, double t_from, double *t_root
   int ne, best = -1;
   fesd_last_events(it, &ev, &ne);
   for (int e = 0; e < ne; e++) {
-    if (ev[e].kind != FESD_EVENT_ROOT || !(ev[e].t > t_from)) continue;
-    const int up = ev[e].n_after == 1 && ev[e].after[0] == 0; /* into r > 0 */
-    const int dir = it->wrap.user.root_dir ? it->wrap.user.root_dir[ev[e].sys] : 0;
-    if ((dir > 0 && !up) || (dir < 0 && up)) continue;
+    if (ev[e].kind != FESD_EVENT_ROOT || !(ev[e].t > t_from) || !root_wanted(it, &ev[e])) continue;
     if (best < 0 || ev[e].t < ev[best].t) best = e;
   }
   if (best >= 0) *t_root = ev[best].t;
@@ -222,8 +228,11 @@ static int integrate(fesd_integrator *it, const double *u, double t_out, fesd_in
       info->newton_iter += si.newton_iter;
       if (st) break;
     }
+    const int logged = it->log_n;
     if ((st = log_events(it))) break;
     info->steps++;
+    info->switch_steps += it->log_n > logged;
+    info->events += it->log_n - logged;
     if (root >= 0) {
       info->root = root;
       st = FESD_ROOT;
@@ -261,7 +270,6 @@ int fesd_integrate_grid(fesd_integrator *it, const double *u, int n, const doubl
     /* with dense output: one call to the last time, the grid from the step polynomials */
     const double target = dense ? t_out[n - 1] : t_out[done];
     fesd_integrate_info si;
-    double t_prev = it->t;
     if (dense) { /* step by step, so that each step's polynomials are still there */
       while (done < n && t_out[done] <= it->t) {
         memcpy(x_out + (size_t)done * it->nxu, it->x, (size_t)it->nxu * sizeof(double));
@@ -273,6 +281,8 @@ int fesd_integrate_grid(fesd_integrator *it, const double *u, int n, const doubl
       st = fesd_integrate(it, u, target, &si);
     }
     info->steps += si.steps;
+    info->switch_steps += si.switch_steps;
+    info->events += si.events;
     info->rejected += si.rejected;
     info->failed_attempts += si.failed_attempts;
     info->newton_iter += si.newton_iter;
@@ -291,7 +301,6 @@ int fesd_integrate_grid(fesd_integrator *it, const double *u, int n, const doubl
       info->root = si.root;
       break;
     }
-    (void)t_prev;
   }
   info->t = it->t;
   info->n_done = done;
