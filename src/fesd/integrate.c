@@ -157,11 +157,24 @@ static int root_crossed(const fesd_integrator *it, double t_from, double *t_root
 
 /* Undo the last accepted step (a rejection): the state, sensitivities and records of its start. */
 static void rollback(fesd_integrator *it) {
+  /* the step's work stays counted (iterations, factorizations); its events and its share
+   * of the per-step means go */
+  fesd_stats *S = &it->stats;
+  S->events -= it->n_events;
+  S->steps--;
+  S->rejected_steps++;
+  if (it->last_sw) {
+    S->switch_steps--;
+    it->sum_iter_sw -= it->last_iter;
+    S->mean_iter_switch_step = S->switch_steps > 0 ? it->sum_iter_sw / S->switch_steps : 0;
+  } else {
+    it->sum_iter_ord -= it->last_iter;
+    const int ord = S->steps - S->switch_steps;
+    S->mean_iter_ordinary_step = ord > 0 ? it->sum_iter_ord / ord : 0;
+  }
   fesd__load(it, &it->bk);
   it->n_el = 0;
   it->n_events = 0;
-  it->stats.steps--;
-  it->stats.rejected_steps++;
 }
 
 /* Integrate to t_out (one_step: return after one accepted step). */

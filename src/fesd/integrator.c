@@ -426,6 +426,8 @@ int fesd_step(fesd_integrator *it, const double *u, double T, fesd_step_info *in
   S->events += it->n_events;
   S->time += info->time;
   int sw = info->switch_step || info->splits > 0 || info->substeps > 0;
+  it->last_sw = sw;
+  it->last_iter = info->newton_iter;
   if (sw) {
     S->switch_steps++;
     it->sum_iter_sw += info->newton_iter;

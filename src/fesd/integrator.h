@@ -95,6 +95,7 @@ struct fesd_integrator {
   fesd__violation *scan_buf; /* nsys */
   int step_flags;          /* FESD_FLAG_* of the current fesd_step */
   int nonunique;
+  int last_sw, last_iter; /* the last accepted step: a switch step?, its iterations (stats) */
   int exit_pinned; /* the accepted sub-step's exits are pinned (exit rows on the plan path) */           /* the step started on a surface that the fields on both sides leave */
   /* the switch plan of the current (sub)step and the active set after each switch (rows of
    * nth flags; only the switch's subsystem is used) */

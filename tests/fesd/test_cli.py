@@ -64,6 +64,19 @@ BAD = [
     (["--problem", "sign-a", "--nsim"], 2, "--nsim"),
     (["--problem", "sign-a", "--family", "lobatto3a", "--stages", "1"], 2, "FESD_ERR_UNSUPPORTED_TABLEAU"),
     (["--problem", "sign-a", "--csv", "/nonexistent-dir/x.csv"], 1, "/nonexistent-dir/x.csv"),
+    (["--problem", "sign-a", "--events", "/nonexistent-dir/e.csv"], 1, "/nonexistent-dir/e.csv"),
+    (["--problem", "sign-a", "--rtol", "0"], 2, "--rtol"),
+    (["--problem", "sign-a", "--rtol", "1"], 2, "--rtol"),
+    (["--problem", "sign-a", "--rtol", "nan"], 2, "--rtol"),
+    (["--problem", "sign-a", "--atol", "-1e-9"], 2, "--atol"),
+    (["--problem", "sign-a", "--max-step", "-1"], 2, "--max-step"),
+    (["--problem", "sign-a", "--tout", "0.5,0.2"], 2, "--tout"),
+    (["--problem", "sign-a", "--tout", "0.5,,0.7"], 2, "--tout"),
+    (["--problem", "sign-a", "--tout", "0:1:1"], 2, "--tout"),
+    (["--problem", "sign-a", "--tout", "1:0:5"], 2, "--tout"),
+    (["--problem", "sign-a", "--tout", "0:1:2.5"], 2, "--tout"),
+    (["--problem", "sign-a", "--tout", "0,7"], 2, "--tout"),
+    (["--problem", "sign-a", "--tout", "-1,0.5"], 2, "--tout"),
 ]
 if os.path.exists("/dev/full"):
     BAD.append((["--problem", "sign-a", "--csv", "/dev/full"], 1, "/dev/full"))
@@ -105,7 +118,40 @@ check(rc == 0 and "sliding-exit  modes {0,1} -> {0}" in out and "t = 1.000000000
 rc, out, err = run(["--problem", "oscillator", "--x0", " 0.5,-0", "--T", "0.25", "--method", "std", "--nfe", "1"])
 check(rc == 0 and "x(T) = " in out and "T=0.25" in out, "oscillator from --x0 with --T: exit %d, %r" % (rc, err))
 
+# --help: usage on the standard output, exit 0
+rc, out, err = run(["--help"])
+check(rc == 0 and out.startswith("usage: fesd-run") and "--rtol" in out and not err, "--help: exit %d, %r" % (rc, out[:60]))
+
+# error-controlled run: output times, CSV of the trajectory and of the events (oscillator:
+# x1 = exp(-1) cos(pi t) before the crossing at t = 1 ... exact solution in C; here the
+# crossing time and the printed error)
+with tempfile.TemporaryDirectory() as d:
+    csv, evf = os.path.join(d, "traj.csv"), os.path.join(d, "ev.csv")
+    rc, out, err = run(["--problem", "oscillator", "--stages", "3", "--rtol", "1e-9", "--tout", "0:1.5:7",
+                        "--csv", csv, "--events", evf, "--quiet"])
+    m = re.search(r"error \|x\(T\) - exact\|_inf = (\S+)", out)
+    check(rc == 0 and m and float(m.group(1)) < 1e-7, "adaptive oscillator: exit %d, %r, %r" % (rc, m and m.group(0), err))
+    rows = [r.split(",") for r in open(csv).read().splitlines()] if os.path.exists(csv) else []
+    check(len(rows) == 8 and rows[0] == ["t", "x1", "x2"] and
+          all(abs(float(rows[1 + k][0]) - 0.25 * k) < 1e-15 for k in range(7)),
+          "adaptive CSV: %d rows, %r" % (len(rows), rows[:2]))
+    # the oscillator's exact solution (src/problems/problems.c), t <= 1: exp(t - 1) (cos, sin)(W t)
+    import math
+    W = 2 * math.pi
+    worst = max(abs(float(rows[1 + k][1]) - math.exp(0.25 * k - 1) * math.cos(W * 0.25 * k)) for k in range(5)) \
+        if len(rows) == 8 else 1
+    check(worst < 1e-7, "adaptive CSV: x1 off by %.1e at the output times before the crossing" % worst)
+    ev = [r.split(",") for r in open(evf).read().splitlines()] if os.path.exists(evf) else []
+    check(len(ev) == 2 and ev[0] == ["t", "subsystem", "kind", "before", "after"] and ev[1][2] == "crossing" and
+          abs(float(ev[1][0]) - 1.0) < 1e-7, "events CSV: %r" % ev)
+# fixed steps with an events file: sign-c's exit
+with tempfile.TemporaryDirectory() as d:
+    evf = os.path.join(d, "ev.csv")
+    rc, out, err = run(["--problem", "sign-c", "--nsim", "20", "--events", evf, "--quiet"])
+    ev = open(evf).read().splitlines() if os.path.exists(evf) else []
+    check(rc == 0 and len(ev) == 2 and ev[1].split(",")[1:] == ["0", "sliding-exit", "0;1", "0"] and abs(float(ev[1].split(",")[0]) - 1) < 1e-12, "sign-c events CSV: %r" % ev)
+
 print("fesd-run: %d bad invocations refused with a message (exit 2 for arguments, 1 for output files), "
-      "%d unwritable standard output, 3 good runs checked" % (n_bad, n_full))
+      "%d unwritable standard output, 6 good runs checked (fixed and error-controlled, CSV of states and events)" % (n_bad, n_full))
 print("%d failures" % fails)
 sys.exit(1 if fails else 0)
