@@ -154,3 +154,39 @@ double bench_slope(const double *x, const double *y, int n, double lo, double hi
   if (used) *used = m;
   return m < 3 ? NAN : (m * sxy - sx * sy) / (m * sxx - sx * sx);
 }
+
+static int cmp_point_time(const void *a, const void *b) {
+  double x = ((const bench_point *)a)->t, y = ((const bench_point *)b)->t;
+  return (x > y) - (x < y);
+}
+
+int bench_front(const bench_point *p, int n, bench_point *f) {
+  bench_point tmp[512];
+  int m = 0, k = 0;
+  for (int i = 0; i < n && m < 512; i++)
+    if (isfinite(p[i].t) && isfinite(p[i].e)) tmp[m++] = (bench_point){p[i].t, fmax(p[i].e, 1e-16), p[i].id};
+  qsort(tmp, (size_t)m, sizeof *tmp, cmp_point_time);
+  for (int i = 0; i < m; i++)
+    if (k == 0 || tmp[i].e < f[k - 1].e) f[k++] = tmp[i];
+  return k;
+}
+
+double bench_front_err(const bench_point *f, int k, double t) {
+  if (k == 0 || t < f[0].t) return NAN;
+  for (int i = 0; i + 1 < k; i++)
+    if (t <= f[i + 1].t) {
+      double a = log(t / f[i].t) / log(f[i + 1].t / f[i].t);
+      return exp((1 - a) * log(f[i].e) + a * log(f[i + 1].e));
+    }
+  return f[k - 1].e;
+}
+
+double bench_front_time(const bench_point *f, int k, double e) {
+  for (int i = 0; i < k; i++)
+    if (f[i].e <= e) {
+      if (i == 0) return f[0].t;
+      double a = log(e / f[i - 1].e) / log(f[i].e / f[i - 1].e);
+      return exp((1 - a) * log(f[i - 1].t) + a * log(f[i].t));
+    }
+  return NAN;
+}

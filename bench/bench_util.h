@@ -67,6 +67,20 @@ double bench_event_near(const bench_run *r, double t, int kind);
 /* Create an integrator for P with settings (reports failures to stderr). */
 fesd_integrator *bench_create(const fesd_problem *P, const fesd_settings *s);
 
+/* Pareto fronts of (CPU time, error) points: the front is increasing in time, decreasing
+ * in error; errors below 1e-16 (exact results) count as 1e-16; points with a NaN are left
+ * out. bench_front writes at most n points to f (n <= 512) and returns their number. */
+typedef struct {
+  double t, e;
+  int id; /* the caller's index of the point */
+} bench_point;
+int bench_front(const bench_point *p, int n, bench_point *f);
+/* Front error at time t, log-log interpolated (NaN before the first point; constant after
+ * the last: more time cannot hurt). */
+double bench_front_err(const bench_point *f, int k, double t);
+/* First time at which the front reaches error e, log-log interpolated (NaN if never). */
+double bench_front_time(const bench_point *f, int k, double e);
+
 /* Least-squares slope of log y against log x over the points with lo < y < hi; *used
  * gets the number of points; NaN below 3 points. */
 double bench_slope(const double *x, const double *y, int n, double lo, double hi, int *used);

@@ -39,47 +39,14 @@ typedef struct {
 static const variant V_FESD = {"fesd", FESD_METHOD_FESD, 1}, V_STD = {"standard", FESD_METHOD_STANDARD, 1},
                      V_PAPER = {"fesd-exit0", FESD_METHOD_FESD, 0};
 
-static int cmp_time(const void *a, const void *b) {
-  double x = ((const point *)a)->t, y = ((const point *)b)->t;
-  return (x > y) - (x < y);
+/* Pareto front of the points (bench_front on their (time, error) pairs). */
+static int front(const point *p, int n, bench_point *f) {
+  bench_point q[MAXP];
+  for (int i = 0; i < n; i++) q[i] = (bench_point){p[i].t, p[i].e, i};
+  return bench_front(q, n, f);
 }
-
-/* Pareto front (increasing time, decreasing error) of the finite points; returns its size. */
-static int front(const point *p, int n, point *f) {
-  point tmp[MAXP];
-  int m = 0, k = 0;
-  for (int i = 0; i < n; i++) /* errors below 1e-16 (exact results) count as 1e-16 */
-    if (isfinite(p[i].t) && isfinite(p[i].e)) {
-      tmp[m] = p[i];
-      tmp[m++].e = fmax(p[i].e, 1e-16);
-    }
-  qsort(tmp, (size_t)m, sizeof *tmp, cmp_time);
-  for (int i = 0; i < m; i++)
-    if (k == 0 || tmp[i].e < f[k - 1].e) f[k++] = tmp[i];
-  return k;
-}
-
-/* log-log interpolated front error at time t (NaN before the first point) */
-static double front_err(const point *f, int k, double t) {
-  if (k == 0 || t < f[0].t) return NAN;
-  for (int i = 0; i + 1 < k; i++)
-    if (t <= f[i + 1].t) {
-      double a = log(t / f[i].t) / log(f[i + 1].t / f[i].t);
-      return exp((1 - a) * log(f[i].e) + a * log(f[i + 1].e));
-    }
-  return f[k - 1].e;
-}
-
-/* first time at which the front reaches error e (NaN if never) */
-static double front_time(const point *f, int k, double e) {
-  for (int i = 0; i < k; i++)
-    if (f[i].e <= e) {
-      if (i == 0) return f[0].t;
-      double a = log(e / f[i - 1].e) / log(f[i].e / f[i - 1].e);
-      return exp((1 - a) * log(f[i - 1].t) + a * log(f[i].t));
-    }
-  return NAN;
-}
+#define front_err bench_front_err
+#define front_time bench_front_time
 
 /* max_k |t_k - t_k*| over the expected switches (nearest event of any kind) */
 static double switch_err(const fesd_problem *P, const bench_run *r) {
@@ -128,7 +95,7 @@ static int sweep(const fesd_problem *P, const variant *v, const int *stages, int
 static FILE *summary, *targets;
 
 static void compare(const char *prob, const char *vname, const point *pf, int nf, const point *ps, int ns) {
-  point F[MAXP], S[MAXP];
+  bench_point F[MAXP], S[MAXP];
   int kf = front(pf, nf, F), ks = front(ps, ns, S);
   if (!kf || !ks) return;
   double lo = fmax(F[0].t, S[0].t), hi = S[ks - 1].t, lsum = 0, rmin = INFINITY, rmax = 0;
@@ -140,7 +107,7 @@ static void compare(const char *prob, const char *vname, const point *pf, int nf
   }
   double gm = m ? exp(lsum / m) : NAN, best = S[ks - 1].e, tf = front_time(F, kf, best), tsb = S[ks - 1].t;
   fprintf(summary, "%s,%s,%.3e,%.3e,%.3e,%.3e,%.3e,%d,%d,%.4f,%.4f,%.3e\n", prob, vname, gm, m ? rmin : NAN,
-          m ? rmax : NAN, best, F[kf - 1].e, S[ks - 1].s, S[ks - 1].nsim, 1e3 * tsb, 1e3 * tf, tsb / tf);
+          m ? rmax : NAN, best, F[kf - 1].e, ps[S[ks - 1].id].s, ps[S[ks - 1].id].nsim, 1e3 * tsb, 1e3 * tf, tsb / tf);
   printf("%s, %s vs standard: error ratio at equal CPU time %.1e (range %.1e .. %.1e); standard's best "
          "error %.1e at %.3f ms, %s reaches it in %.3f ms (%.1fx faster)\n",
          prob, vname, gm, rmin, rmax, best, 1e3 * tsb, vname, 1e3 * tf, tsb / tf);

@@ -18,7 +18,7 @@ for a in "$@"; do
   esac
 done
 BUILD_DIR=${BUILD_DIR:-build-release}
-extra=gnuplot-nox
+extra="gnuplot-nox libsundials-dev" # SUNDIALS: the CVODE comparison of bench_workprec only
 command -v python3 >/dev/null || extra+=" python3"
 FESD_SETUP_EXTRA="$extra" tools/setup.sh "$BUILD_DIR" -Dbuildtype=release
 meson compile -C "$BUILD_DIR" >/dev/null
@@ -32,7 +32,7 @@ else
 fi
 mkdir -p "$OUT"
 t0=$(date +%s)
-for b in order sliding_exit sensitivity stewart_anitescu pareto anatomy growth; do
+for b in order sliding_exit sensitivity stewart_anitescu pareto anatomy growth workprec; do
   echo "== bench_$b"
   "$BUILD_DIR/bench/bench_$b" "${ARGS[@]}" "$OUT"
 done

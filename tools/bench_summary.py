@@ -168,3 +168,13 @@ table(["problem", "method", "s", "N", "sweeps", "backend", "n", "µs/step", "New
         f(r["share_set_rows"]), f(r["share_outside"]), f(r["share_model"]), f(r["us_per_iteration"], 1),
         f(r["us_lib_factor_solve"], 1), f(r["us_lapack_lu"], 1), f(r["ratio_iteration_to_lib"]),
         f(r["ratio_iteration_to_lu"]), f(r["ratio_newton_to_lu"])] for r in rows("anatomy.csv")])
+
+print("### Work-precision: error-controlled FESD, fixed steps, CVODE (CPU ratio at equal error)\n")
+table(["problem", "comparison", "errors below", "ratio (geometric mean)", "min", "max", "target"],
+      [[r["problem"], r["comparison"], e(r["error_below"]), f(r["ratio_gmean"]), f(r["ratio_min"]), f(r["ratio_max"]),
+        r["target"] or "—"] for r in rows("workprec_summary.csv")])
+cv = [r for r in rows("workprec.csv") if r["method"].startswith("cvode")]
+if cv:
+    print("CVODE runs that failed (sliding problems: the sign-following right-hand side chatters): " +
+          ", ".join(f"{p} {sum(1 for r in cv if r['problem'] == p and r['status'] != '0')} of "
+                    f"{sum(1 for r in cv if r['problem'] == p)}" for p in dict.fromkeys(r["problem"] for r in cv)) + "\n")

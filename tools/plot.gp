@@ -1,6 +1,6 @@
 # Plots of the bench CSVs (tools/bench.sh): gnuplot -e "dir='bench/results'" tools/plot.gp
 # writes order.png, pareto.png, sliding_exit.png, sensitivity.png, stewart_anitescu.png,
-# anatomy.png and growth.png next to the CSVs. Curves are selected from the long-format CSVs by filters
+# anatomy.png, growth.png and workprec.png next to the CSVs. Curves are selected from the long-format CSVs by filters
 # that return NaN for the other rows (each curve's rows are contiguous, so lines do not break).
 if (!exists("dir")) dir = "bench/results"
 set datafile separator ","
@@ -147,3 +147,32 @@ set ylabel "ms per step"
 plot f using (sel("series","default") ? column("n") : NaN):"ms_per_step" with linespoints lc rgb word(cols,1) pt 7 title "default (converged guess, few Newton iterations)", \
      f using (sel("series","newton") ? column("n") : NaN):"ms_per_step" with linespoints lc rgb word(cols,2) pt 5 title "one Newton iteration (KLU) every step", \
      f using (sel("series","default") ? column("n") : NaN):(0.0065 * column("n")) with lines lc black dt 2 title "linear"
+
+# ---- work-precision: error-controlled FESD, fixed steps, CVODE ----
+f = dir."/workprec.csv"
+if (system("test -f ".f." && echo 1") eq "1") {
+  set terminal pngcairo size 1600,520 font ",10"
+  set output dir."/workprec.png"
+  reset
+  set datafile separator ","
+  set grid
+  set autoscale xy
+  set format x "10^{%L}"
+  set format y "10^{%L}"
+  set logscale xy
+  set xlabel "CPU time per integration [ms]"
+  set ylabel "|x(T) - x^*(T)|"
+  set key top right font ",8"
+  meths = "fesd-adaptive fesd-fixed cvode-adams cvode-bdf"
+  methname = "FESD-adaptive(rtol) FESD-fixed(N_{sim}) CVODE-Adams CVODE-BDF"
+  set multiplot layout 1,4 title "Work-precision (workprec.csv): marker = stages s (FESD); CVODE: roots + restarts, sign-following RHS (fails on sliding problems)"
+  do for [p in "oscillator sign-c slide-exit-2d stick-slip"] {
+    set title p
+    plot for [m=1:2] for [s=1:5] f using (sel("problem", p) && sel("method", word(meths,m)) && column("stages")==s && column("status")==0 ? column("cpu_ms") : NaN):(floor16(column("error"))) \
+           with linespoints lc rgb word(cols,m) pt s ps 0.6 notitle, \
+         for [m=3:4] f using (sel("problem", p) && sel("method", word(meths,m)) && column("status")==0 ? column("cpu_ms") : NaN):(floor16(column("error"))) \
+           with linespoints lc rgb word(cols,m) pt 7 ps 0.6 notitle, \
+         for [m=1:4] NaN with lines lc rgb word(cols,m) lw 2 title word(methname,m)
+  }
+  unset multiplot
+}

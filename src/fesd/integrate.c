@@ -12,6 +12,7 @@
  * h_new = h min(5, max(0.2, 0.9 err^(-1/q))), no growth right after a rejection. */
 #include <math.h>
 #include <stdlib.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "fesd/step.h"
@@ -77,14 +78,27 @@ static double first_step(fesd_integrator *it, const double *u, double span) {
   }
   if (fesd__model_eval(m, it->t, it->x, u, &pe)) return 1e-6 * span;
   fesd__total_field(it, &pe, th, it->ftot);
-  double d0 = 0, d1 = 0;
-  for (int r = 0; r < it->nxu; r++) {
-    const double w = it->tol_atol[r] + it->tol.rtol * fabs(it->x[r]);
-    d0 = fmax(d0, fabs(it->x[r]) / w);
-    d1 = fmax(d1, fabs(it->ftot[r]) / w);
+  const int nx = it->nxu;
+  double d0 = 0, d1 = 0, *w = it->err_atol, *x1 = it->ftot + it->nx, *f1 = x1 + it->nx;
+  for (int r = 0; r < nx; r++) {
+    w[r] = it->tol_atol[r] + it->tol.rtol * fabs(it->x[r]);
+    d0 = fmax(d0, fabs(it->x[r]) / w[r]);
+    d1 = fmax(d1, fabs(it->ftot[r]) / w[r]);
   }
-  const double h = d0 > 1e-5 && d1 > 1e-5 ? 0.01 * d0 / d1 : 1e-6 * span;
-  return fmin(h, span);
+  double h0 = d0 > 1e-5 && d1 > 1e-5 ? 0.01 * d0 / d1 : 1e-6 * span;
+  h0 = fmin(h0, span);
+  /* Hairer, Norsett & Wanner's starting step: the second derivative from an Euler step with
+   * the same modes, h1 = (0.01 / max(d1, d2))^(1/q) for the estimate's order q */
+  for (int r = 0; r < nx; r++) x1[r] = it->x[r] + h0 * it->ftot[r];
+  for (int r = nx; r < it->nx; r++) x1[r] = it->x[r] + h0; /* the clock */
+  if (fesd__model_eval(m, it->t + h0, x1, u, &pe)) return h0;
+  memcpy(f1, it->ftot, (size_t)it->nx * sizeof(double));
+  fesd__total_field(it, &pe, th, it->ftot);
+  double d2 = 0;
+  for (int r = 0; r < nx; r++) d2 = fmax(d2, fabs(it->ftot[r] - f1[r]) / w[r] / h0);
+  const double dm = fmax(d1, d2);
+  const double h1 = dm > 1e-15 ? pow(0.01 / dm, 1.0 / it->err_q) : fmax(1e-6, 1e-3 * h0);
+  return fmin(fmin(100 * h0, h1), span);
 }
 
 /* Append the last step's events to the integration's log (grown outside the Newton loop). */
@@ -196,6 +210,7 @@ static int integrate(fesd_integrator *it, const double *u, double t_out, fesd_in
   double h = it->h_next > 0 ? it->h_next : it->tol.h_init > 0 ? it->tol.h_init : first_step(it, u, span);
   const double hmin = it->tol.h_min > 0 ? it->tol.h_min : 1e-14 * fmax(fabs(it->t), fabs(t_out));
   int st = FESD_OK, rejected_here = 0;
+  double err_prev = 0;
   while (it->t < t_out) {
     if (info->steps + info->rejected >= it->tol.max_steps) {
       st = FESD_ERR_TOO_MANY_STEPS;
@@ -252,7 +267,13 @@ static int integrate(fesd_integrator *it, const double *u, double t_out, fesd_in
       break;
     }
     if (hh == left) break;
-    h = hh * fmin(rejected_here ? 1.0 : 5.0, fmax(0.2, fac));
+    /* PI control (Gustafsson): the previous accepted error damps the reaction to the noisy
+     * estimate (fewer rejections than err^(-1/q) alone) */
+    double fpi = fac;
+    if (err_prev > 0 && err > 0)
+      fpi = 0.9 * pow(err, -0.7 / it->err_q) * pow(err_prev, 0.4 / it->err_q);
+    h = hh * fmin(rejected_here ? 1.0 : 5.0, fmax(0.2, fpi));
+    err_prev = fmax(err, 1e-4);
     rejected_here = 0;
     if (one_step) break;
   }

@@ -230,7 +230,7 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   it->gbuf = dalloc(nth + nx, &fail);
   it->blk = dalloc((size_t)S->sb, &fail);
   it->vtmp = dalloc(2 * nx, &fail);
-  it->ftot = dalloc(nx, &fail);
+  it->ftot = dalloc(3 * nx, &fail); /* total field; first_step: two more states */
   it->err_atol = dalloc(nx, &fail);
   it->tol_atol = dalloc(nx, &fail);
   it->gdense = dalloc(nx, &fail); /* calloc: zero */
