@@ -6,9 +6,18 @@
  * factorizes the sparse step Jacobian). CPU time per step by bench_time (median of
  * repetitions). Writes OUTDIR/growth.csv and prints the fitted exponent of time per step
  * against n.
- *   bench_growth [--quick] [OUTDIR]   (--quick: n = 8 .. 128, short timings) */
+ * Switching series (growth_switching.csv): the stick-slip chain (belt speed 0.2, q_i(0) =
+ * sin(1.3 i + 0.4): masses stick and slip at different times, up to n/2 switches in one step),
+ * FESD Radau IIA s = 2, h = 0.2, T = 20, one timed run per n: time per simulated second and
+ * per (step + event), events, Newton iterations per event (of the steps that hold events) and
+ * of the worst step; fitted exponent of the time per (step + event) against n.
+ * Chain Pareto (chain_pareto.csv): n = 64, T = 4, FESD against the standard method (same
+ * Radau IIA s = 2, 3, N_FE = 2, same solver), h = 0.2 / 2^k; error at T against Lobatto IIIC
+ * s = 4 at h = 0.2 / 32; CPU ratio at equal error.
+ *   bench_growth [--quick] [OUTDIR]   (--quick: n = 8 .. 128 (switching: .. 64), short timings) */
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 
 #include "bench_util.h"
 #include "problems/friction_chain.h"
@@ -24,6 +33,127 @@ static int run_chain(void *ctx) {
   int st = fesd_set_state(j->it, 0, j->x0, NULL);
   for (int k = 0; k < j->nsteps && !st; k++) st = fesd_step(j->it, NULL, 0.2, NULL);
   return st;
+}
+
+/* One run of the stick-slip chain: nsteps steps of h; CPU seconds, events, iterations. */
+typedef struct {
+  double cpu;
+  int st, steps, events, iters, iters_sw, worst;
+  double x[2048];
+} ss_run;
+
+static int ss_chain(int n, const fesd_settings *set, double h, int nsteps, ss_run *r) {
+  fesd_friction_chain fc;
+  if (fesd_friction_chain_stick_slip(&fc, n)) return FESD_ERR_NOMEM;
+  fesd_integrator *it;
+  int st = fesd_create(&it, &fc.model, set);
+  memset(r, 0, sizeof *r);
+  if (st) {
+    fesd_friction_chain_free(&fc);
+    return r->st = st;
+  }
+  const double c0 = bench_cpu();
+  st = fesd_set_state(it, 0, fc.x0, NULL);
+  for (int k = 0; k < nsteps && !st; k++) {
+    fesd_step_info info;
+    st = fesd_step(it, NULL, h, &info);
+    if (st) break;
+    const fesd_event *ev;
+    int ne;
+    fesd_last_events(it, &ev, &ne);
+    r->steps++, r->events += ne, r->iters += info.newton_iter;
+    if (ne) r->iters_sw += info.newton_iter;
+    if (info.newton_iter > r->worst) r->worst = info.newton_iter;
+  }
+  r->cpu = bench_cpu() - c0;
+  fesd_get_state(it, NULL, r->x);
+  fesd_free(&it);
+  fesd_friction_chain_free(&fc);
+  return r->st = st;
+}
+
+static int switching_series(void) {
+  FILE *out = bench_csv("growth_switching.csv", "n,steps,events,ms_per_sim_second,ms_per_step_or_event,"
+                                                "newton_per_event,worst_step_newton,status");
+  if (!out) return 1;
+  static ss_run r;
+  fesd_settings set;
+  fesd_settings_default(&set);
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  int m = 0, rc = 0;
+  printf("\nswitching series: stick-slip chain, Radau IIA s = 2, h = 0.2, T = 20\n");
+  printf("%6s %7s %9s %14s %16s %12s %11s\n", "n", "events", "max/step", "ms/sim second", "ms/(step+event)",
+         "iter/event", "worst step");
+  for (int n = 8; n <= (bench_opt.quick ? 64 : 1024); n *= 2) {
+    int st = ss_chain(n, &set, 0.2, 100, &r);
+    const double per = 1e3 * r.cpu / (r.steps + r.events), pev = r.events ? (double)r.iters_sw / r.events : 0;
+    printf("%6d %7d %9s %14.2f %16.3f %12.2f %11d%s\n", n, r.events, "", 1e3 * r.cpu / (0.2 * r.steps), per, pev,
+           r.worst, st ? "  FAILED" : "");
+    fprintf(out, "%d,%d,%d,%.6f,%.6f,%.3f,%d,%d\n", n, r.steps, r.events, 1e3 * r.cpu / (0.2 * r.steps), per, pev,
+            r.worst, st);
+    fflush(stdout);
+    rc |= st != 0;
+    double lx = log((double)n), ly = log(per);
+    sx += lx, sy += ly, sxx += lx * lx, sxy += lx * ly, m++;
+  }
+  printf("switching: fitted exponent of time per (step + event) vs n: %.2f (target <= 1.2)\n",
+         (m * sxy - sx * sy) / (m * sxx - sx * sx));
+  fclose(out);
+  return rc;
+}
+
+static int chain_pareto(void) {
+  FILE *out = bench_csv("chain_pareto.csv", "method,s,h,cpu_ms,error,events,status");
+  if (!out) return 1;
+  static ss_run ref, r;
+  const int n = 64, K = bench_opt.quick ? 3 : 5;
+  const double T = 4;
+  fesd_settings set;
+  fesd_settings_default(&set);
+  set.family = FESD_RK_LOBATTO_IIIC;
+  set.stages = 4;
+  if (ss_chain(n, &set, 0.2 / 32, (int)lround(T / (0.2 / 32)), &ref)) {
+    fprintf(stderr, "bench_growth: chain reference failed\n");
+    return 1;
+  }
+  printf("\nchain n = 64, T = 4: FESD against the standard method (reference Lobatto IIIC s = 4, h = 0.00625, %d "
+         "events)\n", ref.events);
+  bench_point pf[16], ps[16];
+  int nf = 0, nsd = 0;
+  for (int meth = 0; meth < 2; meth++)
+    for (int s = 2; s <= 3; s++)
+      for (int k = 0; k < K; k++) {
+        fesd_settings_default(&set);
+        set.method = meth ? FESD_METHOD_STANDARD : FESD_METHOD_FESD;
+        set.stages = s;
+        const double h = 0.2 / (1 << k);
+        int st = ss_chain(n, &set, h, (int)lround(T / h), &r);
+        double err = st ? NAN : 0;
+        for (int i = 0; i < 2 * n && !st; i++) err = fmax(err, fabs(r.x[i] - ref.x[i]));
+        const char *name = meth ? "standard" : "fesd";
+        printf("  %-8s s=%d h=%-8g %9.2f ms  err %.2e  events %d%s\n", name, s, h, 1e3 * r.cpu, err, r.events,
+               st ? "  FAILED" : "");
+        fprintf(out, "%s,%d,%g,%.6f,%.6e,%d,%d\n", name, s, h, 1e3 * r.cpu, err, r.events, st);
+        bench_point p = {st ? NAN : r.cpu, err, 0};
+        if (meth) ps[nsd] = p, ps[nsd].id = nsd, nsd++;
+        else pf[nf] = p, pf[nf].id = nf, nf++;
+        fflush(stdout);
+      }
+  bench_point F[16], S[16];
+  int kf = bench_front(pf, nf, F), ks = bench_front(ps, nsd, S);
+  double lsum = 0, rmin = INFINITY;
+  int m = 0;
+  if (kf && ks) {
+    const double lo = fmax(F[0].t, S[0].t), hi = S[ks - 1].t;
+    for (int i = 0; i <= 20 && lo <= hi; i++) {
+      const double t = lo * pow(hi / lo, i / 20.0), q = bench_front_err(S, ks, t) / bench_front_err(F, kf, t);
+      if (isfinite(q)) lsum += log(q), rmin = fmin(rmin, q), m++;
+    }
+  }
+  printf("chain n = 64: error of standard / FESD at equal CPU time: geometric mean %.3g, min %.3g (%d samples; "
+         "target >= 1e3)\n", m ? exp(lsum / m) : NAN, m ? rmin : NAN, m);
+  fclose(out);
+  return 0;
 }
 
 int main(int argc, char **argv) {
@@ -71,5 +201,7 @@ int main(int argc, char **argv) {
            (m * sxy - sx * sy) / (m * sxx - sx * sx));
   }
   fclose(out);
+  rc |= switching_series();
+  rc |= chain_pareto();
   return rc;
 }

@@ -183,6 +183,7 @@ int fesd__rows_active(fesd_integrator *it, const unsigned char *act, const int *
   /* exits: stiffly accurate methods pin the pair of the last stage (the element end);
    * boundary-point methods the extrapolated theta in the C row (system.h, exit_ext) */
   fesd__system_set_exits(S, bmode, exit_mode);
+  fesd__system_set_lb_mask(S, act);
   for (int k = 1; k < S->N; k++)
     if (bmode && bmode[k] == 2) {
       if (S->bp) it->eq_active[fesd__rowC(S, k)] = 1;

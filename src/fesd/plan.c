@@ -241,6 +241,47 @@ static void start_jump(fesd_integrator *it, int k, const unsigned char *newset) 
   memcpy(it->act0 + m->th_off[k], newset + m->th_off[k], (size_t)(m->th_off[k + 1] - m->th_off[k]));
 }
 
+/* Whether the switch of subsystem j can make theta of subsystem k jump at time t: some
+ * field difference of j's modes has a component along grad (g_i - g_l) of k (i the leaving
+ * mode, l another active one), relative to the sizes (1e-8). Otherwise k's sliding
+ * multiplier is continuous there and its exit is a pinned one. */
+static int coupled(fesd_integrator *it, const double *z, double t, int k, int i, int j, int *out) {
+  fesd__system *S = &it->sys;
+  fesd__model *m = &it->model;
+  *out = 0;
+  double *x = it->gbuf + it->nth;
+  fesd__state_at(it, z, S->N, t, x);
+  fesd__point_eval pe = {0};
+  pe.F = it->pscr.F;
+  pe.g = it->pscr.g;
+  pe.dgdx = it->pscr.dgdx;
+  int st = fesd__model_eval(m, S->t0 + t, x, S->u, &pe);
+  if (st) return st;
+  int l = -1; /* another mode of k active just before t */
+  const unsigned char *P = it->act0;
+  for (int e = 0; e < it->n_plan; e++)
+    if (it->plan[e].sys == k && it->plan[e].t <= t) P = after(it, e);
+  for (int q = m->th_off[k]; q < m->th_off[k + 1]; q++)
+    if (q != i && P[q]) l = q;
+  if (l < 0) return FESD_OK;
+  double *gd = it->gdense; /* zero outside this call */
+  fesd__dg_axpy(m, &pe, i, 1.0, gd);
+  fesd__dg_axpy(m, &pe, l, -1.0, gd);
+  const int *rows = m->rows[j], nr = m->nr[j], a = m->th_off[j], b = m->th_off[j + 1];
+  double gmax = 0, fmx = 0, dmax = 0;
+  for (int c = 0; c < m->ncol[k]; c++) gmax = fmax(gmax, fabs(gd[m->cols[k][c]]));
+  for (int p = a; p < b; p++)
+    for (int r = 0; r < nr; r++) fmx = fmax(fmx, fabs(pe.F[m->Foff[p] + r]));
+  for (int p = a + 1; p < b; p++) {
+    double d = 0;
+    for (int r = 0; r < nr; r++) d += gd[rows[r]] * (pe.F[m->Foff[p] + r] - pe.F[m->Foff[a] + r]);
+    dmax = fmax(dmax, fabs(d));
+  }
+  for (int c = 0; c < m->ncol[k]; c++) gd[m->cols[k][c]] = 0.0;
+  *out = dmax > 1e-8 * gmax * fmx;
+  return FESD_OK;
+}
+
 static int update_one(fesd_integrator *it, const double *z, const fesd__violation *v, double T) {
   const fesd__model *m = &it->model;
   const int k = v->sys, a = m->th_off[k], b = m->th_off[k + 1];
@@ -299,9 +340,12 @@ static int update_one(fesd_integrator *it, const double *z, const fesd__violatio
   double t_new = v->t;
   int jump = 0;
   if (!v->enter)
-    for (int q = 0; q < it->n_plan; q++) {
+    for (int q = 0; q < it->n_plan && !jump; q++) {
       const fesd__switch *o = &it->plan[q];
-      if (o->sys != k && !o->exit && o->t >= v->lo && o->t < v->hi) t_new = o->t, jump = 1;
+      if (o->sys == k || o->exit || !(o->t >= v->lo && o->t < v->hi)) continue;
+      int st = coupled(it, z, o->t, k, v->mode, o->sys, &jump);
+      if (st) return st;
+      if (jump) t_new = o->t;
     }
   if (it->n_plan >= it->cap_plan) return FESD_ERR_TOO_MANY_SWITCHES;
   fesd__switch *w = &it->plan[it->n_plan];

@@ -37,6 +37,10 @@ static int hard_failure(int st) {
  * is smooth, from a regridded converged solution); one that does not is changed rather than
  * iterated on. */
 #define PLAN_ITER 15
+/* Solves with the row weights recomputed at the previous solution: the weights of a guess
+ * can be far from those of the solution (a stage value far off makes its rows' sizes
+ * large); each further pass starts converged and costs one or two iterations. */
+#define WEIGHT_PASSES 5
 /* Sub-steps cut short after a failed plan solve, per step attempt. */
 #define MAX_SHORTEN 3
 /* A sub-step ends before this many boundaries when the plan holds more (see plan_cut). */
@@ -56,6 +60,7 @@ static int rows_select(fesd_integrator *it, const int *switch_at) {
   }
   memset(it->pair_mode, FESD_NCP_PAIR_FB, (size_t)S->n_pair);
   fesd__system_set_exits(S, NULL, NULL);
+  fesd__system_set_lb_mask(S, NULL);
   int st = fesd__set_border(it);
   return st ? st : fesd_ncp_set_rows(it->ncp, it->eq_active, it->pair_mode);
 }
@@ -95,7 +100,7 @@ static int solve(fesd_integrator *it, double *z, double sigma, double tol, int m
   ns.max_iter = max_iter;
   fesd_ncp_update_settings(it->ncp, &ns);
   int st = FESD_OK;
-  for (int pass = 0; pass < 3; pass++) {
+  for (int pass = 0; pass < WEIGHT_PASSES; pass++) {
     if ((st = fesd__system_weights(S, z))) break;
     if (getenv("FESD_DEBUG2")) {
       fprintf(stderr, "pass %d weights:", pass);
@@ -106,6 +111,12 @@ static int solve(fesd_integrator *it, double *z, double sigma, double tol, int m
       double res;
       if ((st = fesd_ncp_residual(it->ncp, z, sigma, NULL, &res))) break;
       info->residual = res;
+      if (getenv("FESD_DEBUG4") && res > tol) {
+        fesd__system_eval(z, it->raw, NULL, S);
+        int best = -1;
+        for (int r = 0; r < S->n_eq; r++) if (it->eq_active[r] && (best < 0 || fabs(it->raw[r]) > fabs(it->raw[best]))) best = r;
+        fprintf(stderr, "pass %d res %.2e worst eq row %d raw %.3e w %.3e (rel) nraw %d rH0 %d rC0 %d erows %d s*rs %d\n", pass, res, best, it->raw[best], S->wraw[best], S->n_raw, S->rH0, S->rC0, S->erows, S->s * S->rs);
+      }
       if (res <= tol) return FESD_OK;
       homotopy = 0; /* continue from the solution */
     }
@@ -468,8 +479,10 @@ static int plan_path(fesd_integrator *it, double *T, fesd_step_info *info) {
       if (st) return st;
       if ((st = set_h_bounds(it, S->T, 1))) return st;
       if ((st = fesd__regrid_guess(it, zp, Np, z))) return st;
+      const int it0 = info->newton_iter;
       st = fixed_solve(it, z, it->set.max_iter < PLAN_ITER ? it->set.max_iter : PLAN_ITER, info);
       if (getenv("FESD_DEBUG")) fprintf(stderr, "  solve N=%d: %s res %.2e\n", S->N, fesd_status_name(st), info->residual);
+      if (getenv("FESD_ITSTAT")) fprintf(stderr, "ITSTAT %d %d\n", st == FESD_OK, info->newton_iter - it0);
       if (st == FESD_OK) break;
       if (hard_failure(st)) return st;
       if (fesd__plan_retreat(it)) continue;

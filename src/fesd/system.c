@@ -26,6 +26,7 @@ void fesd__system_free(fesd__system *S) {
   free(S->lam00_dp);
   free(S->tmp);
   free(S->exit_ext);
+  free(S->lbm);
   free(S->LK);
   free(S->dgl);
   free(S->dgul);
@@ -53,13 +54,26 @@ static const double *elem_start(const fesd__system *S, const double *z, int n) {
   return n == 0 ? S->x0 : z + S->xo[n - 1];
 }
 
+void fesd__system_set_lb_mask(fesd__system *S, const unsigned char *act) {
+  const int nth = S->nth;
+  for (int n = 0; n < S->N; n++)
+    for (int i = 0; i < nth; i++)
+      S->lbm[n * nth + i] = !act || !act[(size_t)(n * S->s + S->s - 1) * nth + i];
+}
+
+/* Weight of the boundary lambda LB_i at the end of element n in the cross complementarity
+ * (1: lambda00 and the stage lambdas of stiffly accurate methods). */
+static inline double lb_count(const fesd__system *S, int n, int i) {
+  return S->bp && n >= 0 ? (double)S->lbm[n * S->nth + i] : 1.0;
+}
+
 double fesd__cross_value(const fesd__system *S, const double *z, int n) {
   int s = S->s, nth = S->nth;
   const double *L = fesd__left_lambda(S, z, n);
   const double *R = S->bp ? fesd__right_lambda(S, z, n) : NULL;
   double c = 0;
   for (int i = 0; i < nth; i++) {
-    double Th = 0, Lt = L[i] + (R ? R[i] : 0), diag = 0;
+    double Th = 0, Lt = lb_count(S, n - 1, i) * L[i] + (R ? lb_count(S, n, i) * R[i] : 0), diag = 0;
     for (int j = 0; j < s; j++) {
       double th = z[fesd__th(S, n, j) + i], la = z[fesd__la(S, n, j) + i];
       Th += th;
@@ -189,8 +203,9 @@ static inline __attribute__((always_inline)) void emit_body(const fesd__system *
       const double *R = (S->bp && S->lbo[n] >= 0 && values) ? z + S->lbo[n] : NULL;
       for (int i = 0; i < nth; i++) {
         double Th = 0, Lt = 0;
+        const double cl = values ? lb_count(S, n - 1, i) : 0, cr = values ? lb_count(S, n, i) : 0;
         if (values) {
-          Lt = L[i] + (R ? R[i] : 0);
+          Lt = cl * L[i] + (R ? cr * R[i] : 0);
           for (int j = 0; j < s; j++) {
             Th += z[fesd__th(S, n, j) + i];
             Lt += z[fesd__la(S, n, j) + i];
@@ -204,9 +219,9 @@ static inline __attribute__((always_inline)) void emit_body(const fesd__system *
         }
         if (n > 0) {
           int col = S->bp ? S->lbo[n - 1] + i : fesd__la(S, n - 1, s - 1) + i;
-          EMIT(E, rC, col, w * Th);
+          EMIT(E, rC, col, w * Th * cl);
         }
-        if (S->bp && S->lbo[n] >= 0) EMIT(E, rC, S->lbo[n] + i, w * Th);
+        if (S->bp && S->lbo[n] >= 0) EMIT(E, rC, S->lbo[n] + i, w * Th * cr);
       }
     }
   }
@@ -292,12 +307,14 @@ int fesd__system_init(fesd__system *S, fesd__model *m, const fesd_tableau *tab, 
   S->refG = calloc((size_t)nsys, sizeof(double));
   S->wth = malloc((size_t)nth * sizeof(double));
   S->exit_ext = malloc((size_t)(N + 1) * sizeof(int));
-  if (!S->exit_ext || !S->el || !S->xo || !S->ho || !S->lbo || !S->rel || !S->rlb || !S->rx || !S->wG || !S->wth ||
+  S->lbm = malloc((size_t)N * nth + 1);
+  if (!S->exit_ext || !S->lbm || !S->el || !S->xo || !S->ho || !S->lbo || !S->rel || !S->rlb || !S->rx || !S->wG || !S->wth ||
       !S->magX || !S->magV || !S->refX || !S->refV || !S->magG || !S->refG)
     goto nomem;
   for (int k = 0; k < nsys; k++) S->wG[k] = 1.0;
   for (int i = 0; i < nth; i++) S->wth[i] = 1.0;
   for (int k = 0; k <= N; k++) S->exit_ext[k] = -1;
+  memset(S->lbm, 1, (size_t)N * nth + 1);
   int off = 0, row = 0;
   for (int n = 0; n < N; n++) {
     S->el[n] = off;

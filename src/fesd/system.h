@@ -78,6 +78,13 @@ typedef struct {
    * every boundary time at an exit). */
   int *exit_ext;
   double ext[FESD_RK_MAX_STAGES];
+  /* Boundary-point methods: lbm[n * nth + i] = 1 if the boundary lambda LB_i at the end of
+   * element n counts in the cross-complementarity rows. LB has no sign constraint: for a
+   * mode active at the element's last stage it is zero only up to the drift of the sliding
+   * stages from the surface (O(h^2s)), with either sign, so with fixed active sets it is
+   * left out (it would make the sum of signed products, not each product, vanish); the FB
+   * path counts all. */
+  unsigned char *lbm;
   double *LK, *dgl, *dgul, *xs;
   fesd__point_eval pl;  /* scratch: switch Jacobians at x_n + delta v_1 */
   /* sizes at the last weighting (per state component: X rows, V rows; per subsystem: the
@@ -136,6 +143,10 @@ int fesd__system_param_jac(fesd__system *S, const double *z, double *out);
 /* Exit rows of the current layout: boundary k pins the exit of mode exit_mode[k] when
  * bmode[k] == 2 and the method has boundary points (see exit_ext); bmode NULL: none. */
 void fesd__system_set_exits(fesd__system *S, const int *bmode, const int *exit_mode);
+
+/* Cross-complementarity mask of the boundary lambdas (see lbm): act (N*s blocks of nth
+ * flags, per stage) leaves out the modes active at each element's last stage; NULL: all. */
+void fesd__system_set_lb_mask(fesd__system *S, const unsigned char *act);
 
 /* Compact cross-complementarity value of element n at z. */
 double fesd__cross_value(const fesd__system *S, const double *z, int n);

@@ -157,6 +157,10 @@ static void scan_signs(fesd_integrator *it, const double *z, const unsigned char
             val = 0;
             for (int l = 0; l < s; l++) val += S->ext[l] * z[fesd__th(S, n, l) + i];
           } else {
+            /* a mode that enters at this boundary: its boundary lambda is the switching
+             * value (zero up to the cross-complementarity tolerance; the LP values of a
+             * boundary-point method are not sign-constrained) */
+            if (n + 1 < S->N && act[(size_t)((n + 1) * s) * nth + i]) continue;
             val = z[S->lbo[n] + i] * S->wth[i];
           }
         }

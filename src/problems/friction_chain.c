@@ -109,3 +109,10 @@ int fesd_friction_chain_init(fesd_friction_chain *fc, int n, double vb) {
                            .sw = fc_sw, .sw_jac = fc_sw_jac, .user = fc, .sparsity = fc->sp};
   return FESD_OK;
 }
+
+int fesd_friction_chain_stick_slip(fesd_friction_chain *fc, int n) {
+  int st = fesd_friction_chain_init(fc, n, 0.2);
+  if (st) return st;
+  for (int i = 0; i < n; i++) fc->x0[i] = sin(1.3 * i + 0.4);
+  return FESD_OK;
+}

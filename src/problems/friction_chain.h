@@ -19,6 +19,10 @@ typedef struct {
 
 /* vb: belt speed (a large vb keeps every mass slipping: no switches) */
 int fesd_friction_chain_init(fesd_friction_chain *fc, int n, double vb);
+/* The stick-slip chain: a slow belt (vb = 0.2) and displacements q_i(0) = sin(1.3 i + 0.4),
+ * v(0) = 0, so that masses stick and slip at different times (many switches per step of
+ * length 0.2 once n is large). */
+int fesd_friction_chain_stick_slip(fesd_friction_chain *fc, int n);
 void fesd_friction_chain_free(fesd_friction_chain *fc);
 
 #endif
