@@ -147,7 +147,6 @@ void fesd__impose_active(fesd_integrator *it, double *z, const unsigned char *ac
  * time (element n depends on element n - 1 only through x_n). A pinned exit has no boundary
  * row: the second row of its pinned pair takes that place. */
 int fesd__set_border(fesd_integrator *it) {
-  if (getenv("NOBORDER")) return fesd_ncp_set_border(it->ncp, NULL, NULL);
   fesd__system *S = &it->sys;
   memset(it->raw_border, 0, (size_t)S->n_raw);
   memset(it->col_border, 0, (size_t)S->n);

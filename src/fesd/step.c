@@ -20,7 +20,6 @@
 #include <math.h>
 #include <string.h>
 
-#include <stdio.h>
 #include <stdlib.h>
 #include "common/timer.h"
 #include "fesd/integrator.h"
@@ -73,7 +72,6 @@ static int set_h_bounds(fesd_integrator *it, double T, int plan) {
     it->ub[i] = INFINITY;
   }
   for (int n = 0; n < S->N; n++) {
-    if (getenv("NOBOUNDS")) plan = 0;
     it->lb[S->ho[n]] = plan ? it->hlo[n] : 1e-9 * T;
     it->ub[S->ho[n]] = plan ? it->hhi[n] : T;
   }
@@ -102,51 +100,16 @@ static int solve(fesd_integrator *it, double *z, double sigma, double tol, int m
   int st = FESD_OK;
   for (int pass = 0; pass < WEIGHT_PASSES; pass++) {
     if ((st = fesd__system_weights(S, z))) break;
-    if (getenv("FESD_DEBUG2")) {
-      fprintf(stderr, "pass %d weights:", pass);
-      for (int r = 0; r < S->n_raw; r++) fprintf(stderr, " %.2g", S->wraw[r]);
-      fprintf(stderr, "\n");
-    }
     if (pass > 0) {
       double res;
       if ((st = fesd_ncp_residual(it->ncp, z, sigma, NULL, &res))) break;
       info->residual = res;
-      if (getenv("FESD_DEBUG4") && res > tol) {
-        fesd__system_eval(z, it->raw, NULL, S);
-        int best = -1;
-        for (int r = 0; r < S->n_eq; r++) if (it->eq_active[r] && (best < 0 || fabs(it->raw[r]) > fabs(it->raw[best]))) best = r;
-        fprintf(stderr, "pass %d res %.2e worst eq row %d raw %.3e w %.3e (rel) nraw %d rH0 %d rC0 %d erows %d s*rs %d\n", pass, res, best, it->raw[best], S->wraw[best], S->n_raw, S->rH0, S->rC0, S->erows, S->s * S->rs);
-      }
       if (res <= tol) return FESD_OK;
       homotopy = 0; /* continue from the solution */
     }
     fesd_ncp_info ni;
     st = homotopy ? fesd_ncp_solve_homotopy(it->ncp, z, &ni) : fesd_ncp_solve(it->ncp, z, sigma, &ni);
     accumulate(info, &ni);
-    if (st && getenv("FESD_DEBUG2")) {
-      fesd__system_eval(z, it->raw, NULL, S);
-      for (int r = 0; r < S->n_raw; r++) {
-        int used = r < S->n_eq ? it->eq_active[r] : 1;
-        if (r >= S->n_eq) {
-          int pk = (r - S->n_eq) % S->n_pair, bside = r >= S->n_eq + S->n_pair, md = it->pair_mode[pk];
-          used = md == FESD_NCP_PAIR_PIN || (md == FESD_NCP_PAIR_A && !bside) || (md == FESD_NCP_PAIR_B && bside);
-        }
-        if (!used) it->raw[r] = 0.0;
-      }
-      for (int rep = 0; rep < 8; rep++) {
-        int best = -1;
-        for (int r = 0; r < S->n_raw; r++)
-          if ((best < 0 || fabs(it->raw[r]) > fabs(it->raw[best])) && it->raw[r] != 0.0) best = r;
-        if (best < 0) break;
-        const char *ty = "?";
-        int n = -1, j = -1, q = -1;
-        if (best >= S->n_eq) ty = best >= S->n_eq + S->n_pair ? "pairB" : "pairA", q = (best - S->n_eq) % S->n_pair, n = q / (S->s * S->nth), j = (q / S->nth) % S->s, q = q % S->nth;
-        else if (best >= S->rH0) ty = best >= S->rT ? "T" : best >= S->rC0 ? "C" : "H", n = best - S->rH0;
-        else { n = best / S->erows; int o = best % S->erows; if (o < S->s * S->rs) { j = o / S->rs; o %= S->rs; ty = o < S->nx ? "V" : o < S->nx + S->nth ? "G" : "S"; q = o < S->nx ? o : o - S->nx; } else { ty = "X/LB"; q = o - S->s * S->rs; } }
-        fprintf(stderr, "  row %d %s el %d st %d idx %d: %.3g (w %.3g) mode %s\n", best, ty, n, j, q, it->raw[best], S->wraw[best], "");
-        it->raw[best] = 0.0;
-      }
-    }
     if (st) break;
     st = FESD_ERR_MAX_ITER;
   }
@@ -240,25 +203,6 @@ static int fixed_solve(fesd_integrator *it, double *z, int max_iter, fesd_step_i
   int st = fesd__rows_active(it, it->act, it->bmode, it->exit_mode);
   if (st) return st;
   st = solve(it, z, 0.0, it->set.newton_tol, max_iter, 0, info);
-  if (st && getenv("FESD_DEBUG3")) {
-    fesd__system *S = &it->sys;
-    double *raw = malloc(S->n_raw * sizeof(double));
-    fesd__system_eval(z, raw, NULL, S);
-    for (int pass = 0; pass < 6; pass++) {
-      int best = -1;
-      for (int r = 0; r < S->n_eq; r++) if (it->eq_active[r] && (best < 0 || fabs(raw[r]) > fabs(raw[best]))) best = r;
-      if (best < 0) break;
-      const char *ty = "?"; int n = -1;
-      for (int q = 0; q < S->N; q++) { if (best >= S->rel[q] && best < S->rel[q] + S->s * S->rs) { ty = "stage"; n = q; int o = (best - S->rel[q]) % S->rs; ty = o < S->nx ? "V" : o < S->nx + S->nth ? "G" : "S"; }
-        if (S->lbo[q] >= 0 && best >= S->rlb[q] && best < S->rlb[q] + S->nth + S->nsys) ty = "LB", n = q;
-        if (best >= S->rx[q] && best < S->rx[q] + S->nx) ty = "X", n = q; }
-      if (best >= S->rH0 && best < S->rC0) ty = "H"; else if (best >= S->rC0 && best < S->rT) ty = "C"; else if (best == S->rT) ty = "T";
-      fprintf(stderr, "    row %d %s el %d raw %.3e w %.3e\n", best, ty, n, raw[best], S->wraw[best]);
-      raw[best] = 0;
-    }
-    for (int n = 0; n < S->N; n++) fprintf(stderr, "    h[%d]=%.6e lo %.3e hi %.3e\n", n, z[S->ho[n]], it->lb[S->ho[n]], it->ub[S->ho[n]]);
-    free(raw);
-  }
   if (st) return st;
   for (int n = 0; n < it->sys.N; n++)
     if (!(z[it->sys.ho[n]] > 0)) return FESD_ERR_STEP_FAILED;
@@ -337,11 +281,9 @@ static int std_switch(fesd_integrator *it, fesd__violation v, fesd_step_info *in
       if (st) return st;
       fesd__violation v2;
       st = fixed_solve(it, z, it->set.max_iter, info);
-      if (getenv("FESD_DEBUG")) fprintf(stderr, "std cand %d p0 %d: %s\n", c, p0, fesd_status_name(st));
       if (hard_failure(st)) return st;
       if (st == FESD_OK) {
         if ((st = fesd__scan(it, z, it->act, 1, &v2, NULL))) return st;
-        if (getenv("FESD_DEBUG") && v2.found) fprintf(stderr, "  v2 t=%g mode %d enter %d stage %d\n", v2.t, v2.mode, v2.enter, v2.stage);
         if (!v2.found) {
           info->switch_step = 1; /* the active set changed inside the step */
           return FESD_OK;
@@ -422,11 +364,9 @@ static int explicit_std(fesd_integrator *it) {
 static int std_path(fesd_integrator *it, fesd_step_info *info) {
   if (it->tab.is_explicit) return explicit_std(it);
   int st = start_solve(it, info);
-  if (getenv("FESD_DEBUG")) fprintf(stderr, "std start solve: %s\n", fesd_status_name(st));
   if (st) return hard_failure(st) ? st : FESD_ERR_STEP_FAILED;
   fesd__violation v;
   if ((st = fesd__scan(it, it->z, it->act, 1, &v, NULL))) return st;
-  if (getenv("FESD_DEBUG") && v.found) fprintf(stderr, "std viol t=%g mode %d enter %d stage %d\n", v.t, v.mode, v.enter, v.stage);
   return v.found ? std_switch(it, v, info) : FESD_OK;
 }
 
@@ -450,12 +390,6 @@ static int plan_path(fesd_integrator *it, double *T, fesd_step_info *info) {
     fesd__plan_times(it, z);
     fesd__violation v;
     if ((st = fesd__scan(it, z, it->act, 0, &v, it->scan_buf))) return st;
-    if (getenv("FESD_DEBUG")) {
-      fprintf(stderr, "round %d N=%d T=%g plan:", round, S->N, S->T);
-      for (int e = 0; e < it->n_plan; e++) fprintf(stderr, " [t=%.6g sys %d mode %d exit %d kb %d]", it->plan[e].t, it->plan[e].sys, it->plan[e].mode, it->plan[e].exit, it->plan[e].kb);
-      fprintf(stderr, "\n");
-      for (int k = 0; k < it->nsys; k++) if (it->scan_buf[k].found) { fesd__violation *w = &it->scan_buf[k]; fprintf(stderr, "   viol sys %d t=%.6g mode %d enter %d el %d stage %d first %d fil %d\n", k, w->t, w->mode, w->enter, w->element, w->stage, w->first, w->filippov); }
-    }
     if (!v.found) {
       info->switch_step = it->n_plan > 0;
       return FESD_OK;
@@ -479,10 +413,7 @@ static int plan_path(fesd_integrator *it, double *T, fesd_step_info *info) {
       if (st) return st;
       if ((st = set_h_bounds(it, S->T, 1))) return st;
       if ((st = fesd__regrid_guess(it, zp, Np, z))) return st;
-      const int it0 = info->newton_iter;
       st = fixed_solve(it, z, it->set.max_iter < PLAN_ITER ? it->set.max_iter : PLAN_ITER, info);
-      if (getenv("FESD_DEBUG")) fprintf(stderr, "  solve N=%d: %s res %.2e\n", S->N, fesd_status_name(st), info->residual);
-      if (getenv("FESD_ITSTAT")) fprintf(stderr, "ITSTAT %d %d\n", st == FESD_OK, info->newton_iter - it0);
       if (st == FESD_OK) break;
       if (hard_failure(st)) return st;
       if (fesd__plan_retreat(it)) continue;
