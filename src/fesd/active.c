@@ -114,9 +114,10 @@ int fesd__act_start(fesd_integrator *it, const double *u, unsigned char *a, int 
  * subsystem where some active mode has (almost) no weight in the guess (a newly active
  * mode, e.g. a sliding candidate) starts from uniform weights, which keeps the
  * cross-complementarity row of that mode non-degenerate. */
-void fesd__impose_active(fesd_integrator *it, double *z, const unsigned char *act) {
+int fesd__impose_active(fesd_integrator *it, double *z, const unsigned char *act) {
   fesd__system *S = &it->sys;
   const fesd__model *m = &it->model;
+  int changed = 0;
   for (int n = 0; n < S->N; n++) {
     for (int j = 0; j < S->s; j++) {
       const unsigned char *a = act + (size_t)(n * S->s + j) * S->nth;
@@ -135,11 +136,15 @@ void fesd__impose_active(fesd_integrator *it, double *z, const unsigned char *ac
           cnt++;
         }
         int uniform = cnt > 0 && (low < 1e-3 * sum || sum <= 0);
-        for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++)
+        for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) {
+          const double old = th[i];
           if (a[i]) th[i] = uniform ? 1.0 / cnt : th[i] / sum;
+          changed |= !(fabs(th[i] - old) <= 1e-14);
+        }
       }
     }
   }
+  return changed;
 }
 
 /* Border of the sparse LU (fesd_ncp_set_border): the element lengths, the boundary rows and

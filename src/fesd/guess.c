@@ -41,9 +41,9 @@ int fesd__consistent_guess(fesd_integrator *it, double *z) {
           for (int l = 0; l < s; l++) acc += S->tab.A[j][l] * z[fesd__v(S, n, l) + r];
           X[r] = xn[r] + (frozen ? 0.0 : h * acc);
         }
-        int st = fesd__model_eval(m, tn + S->tab.c[j] * h, X, S->u, &pe);
-        if (st) return st;
         const double *th = z + fesd__th(S, n, j);
+        int st = fesd__model_fields_active(m, tn + S->tab.c[j] * h, X, S->u, pe.F, th);
+        if (st) return st;
         double *v = z + fesd__v(S, n, j);
         double *vold = it->vtmp; /* the previous v, to measure the sweep's change */
         memcpy(vold, v, (size_t)nx * sizeof(double));

@@ -506,6 +506,18 @@ int fesd__model_eval(fesd__model *m, double t, const double *x, const double *u,
   return FESD_OK;
 }
 
+int fesd__model_fields_active(fesd__model *m, double t, const double *x, const double *u, double *F,
+                              const double *theta) {
+  m->t = t;
+  for (int i = 0; i < m->nth; i++) {
+    if (theta[i] == 0.0) continue;
+    const int k = m->sys_of[i];
+    int st = call_field(m, k, i - m->th_off[k], x, u, F + m->Foff[i]);
+    if (st) return st;
+  }
+  return FESD_OK;
+}
+
 void fesd__F_axpy(const fesd__model *m, const fesd__point_eval *pe, int i, double a, double *y) {
   const int k = m->sys_of[i], *rows = m->rows[k], nr = m->nr[k];
   const double *f = pe->F + m->Foff[i];

@@ -52,6 +52,10 @@ void fesd__point_free(fesd__point_eval *pe);
 /* Evaluate at (t, x) (u may be NULL when nu == 0). Returns FESD_OK, FESD_ERR_CALLBACK or
  * FESD_ERR_NONFINITE (m->failed names the callback). */
 int fesd__model_eval(fesd__model *m, double t, const double *x, const double *u, fesd__point_eval *out);
+/* Only the fields of the modes with theta_i != 0 (F as in fesd__point_eval; the others are
+ * left as they are): what a stage with fixed multipliers needs. */
+int fesd__model_fields_active(fesd__model *m, double t, const double *x, const double *u, double *F,
+                              const double *theta);
 /* Only g at (t, x). */
 int fesd__model_g(fesd__model *m, double t, const double *x, const double *u, double *g);
 

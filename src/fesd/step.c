@@ -110,6 +110,7 @@ static int solve(fesd_integrator *it, double *z, double sigma, double tol, int m
     fesd_ncp_info ni;
     st = homotopy ? fesd_ncp_solve_homotopy(it->ncp, z, &ni) : fesd_ncp_solve(it->ncp, z, sigma, &ni);
     accumulate(info, &ni);
+    if (st == FESD_OK && ni.iterations == 0) return FESD_OK; /* z unchanged: its weights hold */
     if (st) break;
     st = FESD_ERR_MAX_ITER;
   }

@@ -18,7 +18,7 @@ void fesd__act_from_theta(const fesd_integrator *it, const double *theta, unsign
 /* Active set at the step start; *nonunique set when x0 lies on a surface that the fields on
  * both sides leave (several Filippov solutions). */
 int fesd__act_start(fesd_integrator *it, const double *u, unsigned char *a, int *nonunique);
-void fesd__impose_active(fesd_integrator *it, double *z, const unsigned char *act);
+int fesd__impose_active(fesd_integrator *it, double *z, const unsigned char *act); /* 1: theta changed */
 /* Border flags of the current layout and rows for the solver (fesd_ncp_set_border). */
 int fesd__set_border(fesd_integrator *it);
 int fesd__rows_active(fesd_integrator *it, const unsigned char *act, const int *bmode,
