@@ -455,6 +455,10 @@ int main(int argc, char **argv) {
          S.steps, S.switch_steps, S.splits, S.fallback_steps, S.newton_iter, S.mean_iter_ordinary_step,
          S.max_iter_ordinary_step, S.mean_iter_switch_step, S.max_iter_switch_step, S.factorizations,
          S.events, 1e3 * S.time);
+  if (S.coarse_steps || S.nonunique_steps || S.sens_inaccurate_steps || S.exit_not_pinned_steps)
+    printf("flagged steps: %d too coarse (local error estimate above coarse_tol), %d non-unique start, "
+           "%d inaccurate sensitivities, %d unpinned exits\n", S.coarse_steps, S.nonunique_steps,
+           S.sens_inaccurate_steps, S.exit_not_pinned_steps);
   fesd_free(&it);
   if (fflush(stdout) || ferror(stdout)) {
     fprintf(stderr, "fesd-run: writing the standard output failed: %s\n", strerror(errno));
