@@ -55,6 +55,9 @@ typedef struct {
 /* A saved state (integrator.c): the step start, restored when fesd_step fails, and the start
  * of a sub-step attempt, restored before halving (a failure inside accept, e.g. a callback
  * at the new state, can leave the state half-updated). */
+/* Largest stage system (s n_x unknowns) solved by the dense stage Newton of the guess. */
+#define FESD__GN_MAX 64
+
 typedef struct {
   double t, t_c, *x, *lam, *th, *blk, *Sx, *Su, *ldp;
   int have_ws, have_prev_theta, n_el, n_events;
@@ -82,6 +85,10 @@ struct fesd_integrator {
   /* sensitivities */
   double *Sx, *Su, *Dtmp, *Stmp;
   double *gbuf, *blk, *vtmp; /* vtmp: 2 nx */
+  /* stage Newton of the guess (guess.c), when s nx <= FESD__GN_MAX: matrix, residual, saved
+   * stages, dense Jacobian; pivots; sum theta df/dx on the union pattern (NULL: too large) */
+  double *gn, *gn_jth;
+  int *gn_piv;
   double *ftot, *gdense;     /* nx: a total field; a dense gradient kept zero between uses */
   fesd__point_eval pscr;     /* scratch model evaluation */
   double *pt_t, *pt_q, *pt_l; /* switch prediction: point times and q values */

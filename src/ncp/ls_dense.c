@@ -2,6 +2,7 @@
  * the normal matrix J'J + mu I for Levenberg-Marquardt. */
 #include "ncp/linsolve.h"
 
+#include "common/dense_lu.h"
 #include "common/lapack.h"
 #include "fesd_ncp.h"
 
@@ -11,55 +12,6 @@
 /* Up to this order an unblocked LU beats LAPACK's dgetrf/dgetrs, whose call and
  * blocking overhead dominates small systems (bench/ncp_bench, docs/ncp.md). */
 #define SMALL_LU_MAX_N 48
-
-/* Right-looking LU with partial pivoting, column-major; 0-based pivots.
- * Returns k+1 when column k has no nonzero pivot (as dgetrf's info). */
-static int small_lu(int n, double *a, int *piv) {
-  for (int k = 0; k < n; k++) {
-    double *ck = a + (size_t)k * n, big = fabs(ck[k]);
-    int p = k;
-    for (int i = k + 1; i < n; i++)
-      if (fabs(ck[i]) > big) {
-        big = fabs(ck[i]);
-        p = i;
-      }
-    piv[k] = p;
-    if (big == 0.0) return k + 1;
-    if (p != k)
-      for (int j = 0; j < n; j++) {
-        double t = a[k + (size_t)j * n];
-        a[k + (size_t)j * n] = a[p + (size_t)j * n];
-        a[p + (size_t)j * n] = t;
-      }
-    const double inv = 1.0 / ck[k];
-    for (int i = k + 1; i < n; i++) ck[i] *= inv;
-    for (int j = k + 1; j < n; j++) {
-      double *cj = a + (size_t)j * n, f = cj[k];
-      if (f != 0.0)
-        for (int i = k + 1; i < n; i++) cj[i] -= f * ck[i];
-    }
-  }
-  return 0;
-}
-
-static void small_lu_solve(int n, const double *a, const int *piv, double *x) {
-  for (int k = 0; k < n; k++)
-    if (piv[k] != k) {
-      double t = x[k];
-      x[k] = x[piv[k]];
-      x[piv[k]] = t;
-    }
-  for (int k = 0; k < n; k++) { /* L y = P b, unit diagonal */
-    const double *ck = a + (size_t)k * n, xk = x[k];
-    for (int i = k + 1; i < n; i++) x[i] -= ck[i] * xk;
-  }
-  for (int k = n - 1; k >= 0; k--) { /* U x = y */
-    const double *ck = a + (size_t)k * n;
-    x[k] /= ck[k];
-    const double xk = x[k];
-    for (int i = 0; i < k; i++) x[i] -= ck[i] * xk;
-  }
-}
 
 typedef struct {
   fesd__ls base;
@@ -84,7 +36,7 @@ static int lu_factor(fesd__ls *ls, double *values, double mu) {
   int n = ls->n, info = 0;
   (void)mu;
   d->lu = values;
-  if (n <= SMALL_LU_MAX_N) return small_lu(n, values, d->ipiv) ? FESD_ERR_SINGULAR : FESD_OK;
+  if (n <= SMALL_LU_MAX_N) return fesd__dense_lu(n, values, d->ipiv) ? FESD_ERR_SINGULAR : FESD_OK;
   dgetrf_(&n, &n, values, &n, d->ipiv, &info);
   if (info < 0) return FESD_ERR_LINSOLVE;
   return info > 0 ? FESD_ERR_SINGULAR : FESD_OK;
@@ -94,7 +46,7 @@ static int lu_solve(fesd__ls *ls, double *x) {
   dense_lu *d = (dense_lu *)ls;
   int n = ls->n, one = 1, info = 0;
   if (n <= SMALL_LU_MAX_N) {
-    small_lu_solve(n, d->lu, d->ipiv, x);
+    fesd__dense_lu_solve(n, d->lu, d->ipiv, x);
     return FESD_OK;
   }
   dgetrs_("N", &n, &one, d->lu, &n, d->ipiv, x, &n, &info, 1);
