@@ -178,7 +178,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
 
 #ifndef FESD_LIBFUZZER
 /* seeded driver: N_INPUTS random inputs of 128 bytes (enough for every parameter) */
-#define N_INPUTS 10000
+#define N_INPUTS 6000
 int main(void) {
   pwa_rng rng = {0x5eed2024};
   int count[6] = {0}, n_ev = 0, fails = 0;

@@ -11,6 +11,8 @@
  *                  without switches (x1(T) off by 0.05), and dx(T)/dx0 is not the derivative of
  *                  that map, not flagged
  *  sens-changes-state: the same, x2(0) = -5e-6: sensitivities = 0 and 1 return different states
+ *  radau-exit-sens: Radau IIA s = 3, a sliding entry and exit (affine fields): dx(T)/dx0 11 % off
+ *                  the derivative of the map (4e4 off with finite-difference Jacobians), no flag
  *  gauss-codim2:   Gauss-Legendre entering sliding on an intersection (piecewise-constant fields,
  *                  which FESD integrates exactly): x(T) off by 1.5e-3, flagged SENS_INACCURATE
  *                  only (which says the state is to be trusted) */
@@ -203,6 +205,68 @@ static int missed_exit(void) {
   return fails;
 }
 
+/* found by prop_sens (problem 76): affine fields, subsystem 1 slides from 0.265 to 1.442; Radau
+ * IIA s = 3, N_FE = 2, N_sim = 3: dx(T)/dx0 is 11 % off the derivative of the map (differences
+ * with eps 1e-3 .. 1e-5 agree to 2e-4; below 1e-7 the map is rough: its state jitters by ~1e-7),
+ * 4e4 off with finite-difference Jacobians; no flag */
+static int radau_exit(void) {
+  int fails = 0;
+  pwa_sys S;
+  memset(&S, 0, sizeof(S));
+  S.nx = 2, S.K = 2, S.nu = 1, S.affine = 1;
+  const double a[2][2] = {{0.54306866177765556, 0.8396882925199245}, {-0.83721841533376207, 0.54686865427269127}};
+  const double b[2] = {-0.15549036615693829, -0.24846320444892975};
+  const double d[2][2][2] = {{{-2.0519511308083889, 0.73455252374909674}, {1.2198957604481075, -1.5770768130892603}},
+                             {{-1.0865804102802656, -1.3696447827043925}, {1.0646318923123215, 1.3087173321174752}}};
+  const double A[2][2][4] = {
+      {{-0.15317934020244306, -0.051553016622060688, -0.21184492990398374, -0.33789957160314688},
+       {0.38473615543745299, 0.27630357560392266, -0.25320019958543694, -0.52376712525325508}},
+      {{-0.28357266055736696, -0.27832453981850458, 0.45164294535899352, 0.04788038667859551},
+       {0.26816704435159366, 0.48251891870046759, 0.00088646711146267432, -0.34513854975195069}}};
+  const double B[2][2][2] = {{{0.22121383259560479, 0.47685206779699496}, {0.45580193123412327, -0.41859628816068062}},
+                             {{-0.010620913519158948, 0.1462642344924806}, {-0.04895930279181393, 0.15002906644803482}}};
+  for (int k = 0; k < 2; k++) {
+    S.b[k] = b[k];
+    for (int q = 0; q < 2; q++) S.a[k][q] = a[k][q];
+    for (int i = 0; i < 2; i++)
+      for (int q = 0; q < 2; q++) {
+        S.d[k][i][q] = d[k][i][q];
+        S.B[k][i][q][0] = B[k][i][q];
+        for (int c = 0; c < 2; c++) S.A[k][i][q][c] = A[k][i][q * 2 + c];
+      }
+  }
+  const double x0[2] = {-1.4604422679142617, -1.0508236336365608}, u[1] = {0.21536284353671459};
+  for (int jac = 1; jac >= 0; jac--) {
+    pr_model pm;
+    pr_model_init(&pm, &S, jac);
+    fesd_settings set;
+    fesd_settings_default(&set);
+    set.stages = 3;
+    set.sensitivities = 1;
+    static pr_run r, rp, rm;
+    const int st = pr_integrate(&pm.m, &set, x0, u, 2.0, 3, &r);
+    double worst = 0;
+    for (int j = 0; j < 2; j++) {
+      double fd[3];
+      for (int q = 0; q < 3; q++) { /* eps 1e-3, 1e-4, 1e-5 */
+        const double eps = 1e-3 / pow(10, q);
+        double xp[2] = {x0[0], x0[1]}, xm[2] = {x0[0], x0[1]};
+        xp[j] += eps, xm[j] -= eps;
+        pr_integrate(&pm.m, &set, xp, u, 2.0, 3, &rp);
+        pr_integrate(&pm.m, &set, xm, u, 2.0, 3, &rm);
+        fd[q] = (rp.x[0] - rm.x[0]) / (2 * eps);
+      }
+      worst = fmax(worst, fabs(r.Sx[j * 2] - fd[2]) / fmax(1, fabs(fd[2])));
+      printf("%s Jacobians: dx1(T)/dx0_%d: FESD %.9f, differences of the map %.9f %.9f %.9f (eps 1e-3, 1e-4, 1e-5)\n",
+             jac ? "exact" : "FD", j, r.Sx[j * 2], fd[0], fd[1], fd[2]);
+    }
+    FESD_TEST_CHECK(st == FESD_OK && (worst <= 1e-3 || (r.flags & FESD_FLAG_SENS_INACCURATE)),
+                    "Radau IIA s=3 N_sim=3, %s Jacobians: %s, dx(T)/dx0 vs differences %.2e (relative), flags 0x%x",
+                    jac ? "exact" : "FD", fesd_status_name(st), worst, r.flags);
+  }
+  return fails;
+}
+
 /* found by prop_sens: piecewise-constant fields, slides on c_0 from 0.29 and on both from 0.72 */
 static int gauss_codim2(void) {
   pwa_sys S;
@@ -276,10 +340,13 @@ int main(int argc, char **argv) {
     fails = lobatto_exit();
   } else if (!strcmp(c, "sens-changes-state")) {
     fails = sens_changes_state();
+  } else if (!strcmp(c, "radau-exit-sens")) {
+    fails = radau_exit();
   } else if (!strcmp(c, "gauss-codim2")) {
     fails = gauss_codim2();
   } else {
-    printf("usage: %s codim2-entry|cross-sliding|missed-exit|grid-sens|lobatto-exit|sens-changes-state|gauss-codim2\n",
+    printf("usage: %s codim2-entry|cross-sliding|missed-exit|grid-sens|lobatto-exit|sens-changes-state|"
+           "radau-exit-sens|gauss-codim2\n",
            argv[0]);
     return 2;
   }

@@ -5,8 +5,10 @@
  *  - central differences of the FESD map itself (the same settings from x0 +- eps e_j and
  *    u +- eps e_j, eps = 1e-6 max(1, |v_j|)) by more than 1e-5 max(1, |S|) (per column). Skipped where the map is not
  *    differentiable: a perturbed run fails or its event sequence differs, or (checked only when
- *    a column disagrees) the differences with eps / 10 and 10 eps disagree with it: the map
- *    jumps between nearby discrete solutions with the same events (counted as "jumps");
+ *    a column disagrees) the differences with eps / 10 and 10 eps spread by more than a third of
+ *    S's distance to the nearest of them: the map is not smooth at this scale (it jumps between
+ *    nearby discrete solutions with the same events), so the column is skipped (a run whose other
+ *    columns agree counts as a jump);
  *  - the closed form where there is one: piecewise-constant fields (FESD is exact, so its map
  *    is the exact flow; sensitivities of the reference pwa_ref.c: saltation matrices at
  *    crossings and entries) by more than 1e-5 max(1, |S|), and the issue's reproducer below
@@ -127,13 +129,19 @@ static int check_run(const problem *P, const fesd_settings *set, int jac, tally 
       fd_done = 0; /* the events change: not differentiable */
     } else if (nd == 1) {
       fd_err = fmax(fd_err, e[0]);
-    } else if (nd == 3 && col_err(nx, fd[0], fd[1], NULL) <= 1e-5 && col_err(nx, fd[0], fd[2], NULL) <= 1e-5) {
-      fd_err = fmax(fd_err, fmin(e[0], fmin(e[1], e[2]))); /* consistent differences */
     } else {
-      jump = 1;
+      double spread = 0, emin = INFINITY;
+      for (int a = 0; a < nd; a++) {
+        emin = fmin(emin, e[a]);
+        for (int b = 0; b < a; b++) spread = fmax(spread, col_err(nx, fd[a], fd[b], NULL));
+      }
+      if ((nd == 3 && spread <= 1e-5) || emin > 3 * spread)
+        fd_err = fmax(fd_err, emin); /* smooth, or S farther from every quotient than they spread */
+      else
+        jump = 1;
     }
   }
-  if (jump && fd_done) {
+  if (jump && fd_done && fd_err <= 1e-5) { /* nothing wrong where the map is smooth */
     fd_done = 0;
     ta->jumps++;
     if (ta->jumps <= 2)
