@@ -163,7 +163,8 @@ class Bridge:
                 _memmove(f, buf, nb)
             return 0
         except BaseException as e:  # noqa: B902 - reported by the caller after the C call
-            return self._fail("fields" if self.subs[sys].fields is not None else "field", sys, mode, t, x, e)
+            vec = self.subs[sys].fields is not None  # one call for all modes: no mode to name
+            return self._fail("fields" if vec else "field", sys, None if vec else mode, t, x, e)
 
     def _field_jac(self, sys, mode, t, x, u, dfdx, dfdu, user):
         try:
@@ -195,8 +196,8 @@ class Bridge:
                     _memmove(dfdu, bu, nbu)
             return 0
         except BaseException as e:  # noqa: B902
-            return self._fail("fields_jac" if self.subs[sys].fields_jac is not None else "field_jac",
-                              sys, mode, t, x, e)
+            vec = self.subs[sys].fields_jac is not None
+            return self._fail("fields_jac" if vec else "field_jac", sys, None if vec else mode, t, x, e)
 
     # ---- switching functions / indicators ----
     def _switch(self, sys, t, x, u, c, user):

@@ -64,7 +64,11 @@ class Run:
                 self.dense.add_element(t0, h, vals)
 
     def root_hit(self, i, t, x):
-        """A stop condition i crossed in its direction at (t, x); True if it ends the run."""
+        """A stop condition i crossed in its direction at (t, x); True if it ends the run. A
+        crossing within 1e-9 of the last one of the same condition is the same one (found at a
+        stop and again by the library's next step)."""
+        if self.t_events[i] and abs(t - self.t_events[i][-1]) <= 1e-9 * max(1.0, abs(t)):
+            return False
         self.t_events[i].append(float(t))
         self.y_events[i].append(np.array(x, dtype=float))
         return self.terminal[i] > 0 and len(self.t_events[i]) >= self.terminal[i]
@@ -115,6 +119,34 @@ def _root_events(run, evs, t_from):
     return sorted(out, key=lambda e: e.t)
 
 
+def _roots_at_stop(run, root, t_prev, x_prev):
+    """After FESD_ROOT (stop condition `root` at the current state): the stop conditions that
+    crossed zero in their direction at the same time. fesd_integrate reports one index, and the
+    stop's event reaches the event log only with the next call's first step (a condition that
+    crossed at the same instant never stops a later call), so the others are found here: r_j
+    changed sign (or reached 0) from the state before the call (t_prev, x_prev) to the stop, in
+    its direction (r_j within 1e-9 max(1, |r_j(x_prev)|) of zero counts). True if one of
+    them ends the run."""
+    it = run.it
+    t, x = it.t, it.x
+    hit = [root]
+    if len(run.events) > 1:
+        u = run.u if run.u is not None else np.zeros(0)
+        for j, ev in enumerate(run.events):
+            if j == root:
+                continue
+            r0, r1 = float(np.reshape(ev(t_prev, x_prev, u), ())), float(np.reshape(ev(t, x, u), ()))
+            d = run.dirs[j]
+            # at the stop r_j is zero up to the solver's accuracy, of either sign
+            crossed = r0 * r1 <= 0 or abs(r1) <= 1e-9 * max(1.0, abs(r0))
+            if r0 != 0 and crossed and (d == 0 or d * r0 < 0):
+                hit.append(j)
+    ends = False
+    for i in sorted(hit):
+        ends |= run.root_hit(i, t, x)
+    return ends
+
+
 def _tol_from(t):
     return t + 1e-12 * max(1.0, abs(t))
 
@@ -122,9 +154,7 @@ def _tol_from(t):
 # ---- fixed steps ----
 def run_fixed(run, t0, tf, h, t_eval):
     it, u = run.it, run.u
-    n = max(1, int(np.ceil((tf - t0) / h - 1e-9)))
-    grid = t0 + h * np.arange(n + 1)
-    grid[-1] = tf
+    n = max(1, int(np.ceil((tf - t0) / h - 1e-9)))  # steps of h, the last one to tf
     te = list(t_eval) if t_eval is not None else None
     k_eval = 0
     if te is None:
@@ -136,16 +166,17 @@ def run_fixed(run, t0, tf, h, t_eval):
         t_start, x_start = it.t, it.x
         S_start = run.sensitivities() if it.sensitivities_on else None
         try:
-            it.step(grid[k + 1] - grid[k], u)
+            it.step(h if k < n - 1 else tf - t_start, u)
         except FesdError as e:
             run.fail(e)
         evs = it.last_events()
         run.switch_events.extend(e for e in evs if e.kind != "root")
         stop = None
-        for ev in _root_events(run, evs, _tol_from(t_start)):
-            if run.root_hit(ev.sys, ev.t, _boundary_state(it, ev.t)):
+        for ev in _root_events(run, evs, _tol_from(t_start)):  # earliest first
+            if stop is not None and ev.t > _tol_from(stop.t):
+                break  # after the stop
+            if run.root_hit(ev.sys, ev.t, _boundary_state(it, ev.t)) and stop is None:
                 stop = ev
-                break
         if stop is not None:  # end on the stop condition: the step again, to its time
             run.restart(t_start, x_start, S_start)
             try:
@@ -187,6 +218,7 @@ def run_grid(run, t0, tf, t_eval):
     te = np.asarray(t_eval, dtype=float)
     done = 0
     while done < te.size:
+        t_prev, x_prev = it.t, it.x
         st, xo, info = it.integrate_grid(te[done:], u, raise_on_error=False)
         for j in range(info["n_done"]):
             run.out(te[done + j], xo[j])
@@ -198,9 +230,8 @@ def run_grid(run, t0, tf, t_eval):
                 run.fail(e)
         for k in ("failed_attempts",):
             run.extra[k] += info[k]
-        if st == _lib.FESD_ROOT:
-            if run.root_hit(info["root"], it.t, it.x):
-                raise Stop(1, "A termination event occurred.")
+        if st == _lib.FESD_ROOT and _roots_at_stop(run, info["root"], t_prev, x_prev):
+            raise Stop(1, "A termination event occurred.")
     run.switch_events.extend(e for e in it.event_log() if e.kind != "root")
 
 
@@ -220,6 +251,7 @@ def run_steps(run, t0, tf, tol, max_steps):
             raise Stop(-1, f"FESD_ERR_TOO_MANY_STEPS: more than max_steps = {max_steps} steps")
         it.set_tolerances(tol["rtol"], tol["atol"], h_init=h_prop, h_max=tol["h_max"], h_min=tol["h_min"],
                           max_steps=1)
+        t_prev, x_prev = it.t, it.x
         try:
             st, info = it.integrate(tf, u, allow=(_lib.FESD_ERR_TOO_MANY_STEPS,))
         except FesdError as e:
@@ -232,6 +264,6 @@ def run_steps(run, t0, tf, tol, max_steps):
         run.record_step()
         run.out(it.t, it.x)
         if st == _lib.FESD_ROOT:
-            if run.root_hit(info["root"], it.t, it.x):
+            if _roots_at_stop(run, info["root"], t_prev, x_prev):
                 raise Stop(1, "A termination event occurred.")
             run.restart(it.t, it.x)
