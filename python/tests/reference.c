@@ -5,12 +5,14 @@
  *   fesd_py_reference fixed PROBLEM METHOD FAMILY STAGES N_FE NSIM T [u...]   (fesd_step, sensitivities)
  *   fesd_py_reference integrate PROBLEM FAMILY STAGES RTOL ATOL T [u...]     (fesd_integrate)
  *   fesd_py_reference grid PROBLEM FAMILY STAGES RTOL ATOL N t_1..t_N [u...] (fesd_integrate_grid)
+ *   fesd_py_reference time PROBLEM FAMILY STAGES NSIM T REPS                 (CPU us per fesd_step)
  *
  * Output: one record per line, "name v1 v2 ...". */
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "fesd.h"
 #include "problems/problems.h"
@@ -126,6 +128,29 @@ int main(int argc, char **argv) {
     fesd_get_stats(it, &S);
     printf("stats %d %d %d\n", S.steps, S.switch_steps, S.newton_iter);
     printf("status 0\n");
+    fesd_free(&it);
+    return 0;
+  }
+  if (!strcmp(argv[1], "time") && argc >= 8) { /* the Python benchmark's C baseline */
+    const int nsim = atoi(argv[5]), reps = atoi(argv[7]);
+    const double T = atof(argv[6]);
+    fesd_integrator *it = make(&P, "fesd", argv[3], atoi(argv[4]), 2, 0, NULL, 0);
+    if (!it) return 1;
+    double best = 1e30;
+    for (int r = 0; r < reps; r++) {
+      struct timespec a, b;
+      clock_gettime(CLOCK_THREAD_CPUTIME_ID, &a);
+      fesd_set_state(it, 0.0, P.x0, P.u);
+      for (int k = 0; k < nsim; k++)
+        if ((st = fesd_step(it, P.u, T / nsim, NULL))) return 1;
+      clock_gettime(CLOCK_THREAD_CPUTIME_ID, &b);
+      const double us = ((double)(b.tv_sec - a.tv_sec) * 1e6 + (double)(b.tv_nsec - a.tv_nsec) * 1e-3) / nsim;
+      if (us < best) best = us;
+    }
+    double x[FESD_PROBLEM_MAX_NX];
+    fesd_get_state(it, NULL, x);
+    vec("xend", x, nx);
+    printf("us_per_step %.6g\n", best);
     fesd_free(&it);
     return 0;
   }
