@@ -6,6 +6,11 @@
 
 See docs/python.md.
 """
+try:
+    import numpy  # noqa: F401
+except ImportError as e:  # pragma: no cover - depends on the interpreter
+    raise ImportError("fesd needs numpy: install python3-numpy (tools/setup.sh) and use Debian's python3 "
+                      "(/usr/bin/python3; another python3 first in PATH, e.g. pyenv's, may lack it)") from e
 from ._lib import LIBRARY_PATH, status_name, status_string
 from .errors import CallbackError, FesdError, NonFiniteOutputError, OutputShapeError
 from .integrator import Integrator, StepData, SwitchEvent
