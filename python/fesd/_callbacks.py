@@ -20,6 +20,7 @@ import math
 
 import numpy as np
 
+from . import _lib
 from .errors import NonFiniteOutputError, OutputShapeError
 
 _memmove, _string_at, _isfinite = ctypes.memmove, ctypes.string_at, math.isfinite
@@ -93,7 +94,6 @@ class Bridge:
     """ctypes callbacks for one integrator: model (fesd.Model), events: stop conditions."""
 
     def __init__(self, model, events=()):
-        from . import _lib
         self.model, self.events = model, list(events)
         self.subs = model.subsystems
         self.nx, self.nu = model.nx, model.nu
