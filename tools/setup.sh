@@ -6,7 +6,8 @@ cd "$(dirname "$0")/.."
 BUILD_DIR=${1:-build}
 shift || true
 
-PKGS=(build-essential meson ninja-build pkg-config libsuitesparse-dev libopenblas-dev liblapack-dev libmetis-dev valgrind)
+PKGS=(build-essential meson ninja-build pkg-config libsuitesparse-dev libopenblas-dev liblapack-dev libmetis-dev valgrind
+      python3-numpy python3-matplotlib python3-pytest)
 [ "${FESD_SETUP_EXTRA:-}" ] && PKGS+=(${FESD_SETUP_EXTRA})
 missing=()
 for p in "${PKGS[@]}"; do
@@ -18,6 +19,16 @@ if [ ${#missing[@]} -gt 0 ]; then
   export DEBIAN_FRONTEND=noninteractive
   $SUDO apt-get update -qq
   $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+# The Python package (python/fesd): `import fesd` for Debian's python3 from anywhere, by a .pth
+# file in its user site directory naming python/ of this tree (the last tree set up wins;
+# PYTHONPATH=python, which comes first, works without it). It loads build/libfesd.so of the tree.
+if [ -x /usr/bin/python3 ]; then
+  site=$(/usr/bin/python3 -m site --user-site 2>/dev/null || true)
+  if [ -n "$site" ] && mkdir -p "$site" 2>/dev/null; then
+    printf '%s\n' "$PWD/python" > "$site/fesd-source.pth"
+  fi
 fi
 
 if [ ! -f "$BUILD_DIR/build.ninja" ]; then

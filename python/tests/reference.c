@@ -1,0 +1,195 @@
+/* Reference runs of the C API for the Python tests (python/tests/test_against_c.py): the same
+ * problems (src/problems) integrated by libfesd directly, printed with 17 digits.
+ *
+ *   fesd_py_reference layout
+ *   fesd_py_reference fixed PROBLEM METHOD FAMILY STAGES N_FE NSIM T [u...]   (fesd_step, sensitivities)
+ *   fesd_py_reference integrate PROBLEM FAMILY STAGES RTOL ATOL T [u...]     (fesd_integrate)
+ *   fesd_py_reference grid PROBLEM FAMILY STAGES RTOL ATOL N t_1..t_N [u...] (fesd_integrate_grid)
+ *   fesd_py_reference time PROBLEM FAMILY STAGES NSIM T REPS                 (CPU us per fesd_step)
+ *
+ * Output: one record per line, "name v1 v2 ...". */
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "fesd.h"
+#include "problems/problems.h"
+
+#define OFF(T, f) printf("offset %s.%s %zu\n", #T, #f, offsetof(T, f))
+
+static int layout(void) {
+  printf("size fesd_ncp_settings %zu\n", sizeof(fesd_ncp_settings));
+  OFF(fesd_ncp_settings, max_iter); OFF(fesd_ncp_settings, armijo); OFF(fesd_ncp_settings, max_backtracks);
+  OFF(fesd_ncp_settings, sigma0); OFF(fesd_ncp_settings, lm_mu0); OFF(fesd_ncp_settings, log_user);
+  printf("size fesd_settings %zu\n", sizeof(fesd_settings));
+  OFF(fesd_settings, n_fe); OFF(fesd_settings, newton_tol); OFF(fesd_settings, cc_tol); OFF(fesd_settings, exit_rows);
+  OFF(fesd_settings, coarse_tol); OFF(fesd_settings, max_elements); OFF(fesd_settings, ncp);
+  printf("size fesd_model %zu\n", sizeof(fesd_model));
+  OFF(fesd_model, n_modes); OFF(fesd_model, sign); OFF(fesd_model, field); OFF(fesd_model, sw_jac);
+  OFF(fesd_model, sparsity); OFF(fesd_model, time_dependent); OFF(fesd_model, drift); OFF(fesd_model, drift_sparsity);
+  OFF(fesd_model, n_roots); OFF(fesd_model, roots); OFF(fesd_model, root_dir);
+  printf("size fesd_step_info %zu\n", sizeof(fesd_step_info));
+  OFF(fesd_step_info, fallback); OFF(fesd_step_info, residual); OFF(fesd_step_info, failed_callback);
+  OFF(fesd_step_info, failed_time); OFF(fesd_step_info, failed_path); OFF(fesd_step_info, last_time);
+  printf("size fesd_event %zu\n", sizeof(fesd_event));
+  OFF(fesd_event, sys); OFF(fesd_event, n_after); OFF(fesd_event, before); OFF(fesd_event, after);
+  printf("size fesd_step_data %zu\n", sizeof(fesd_step_data));
+  OFF(fesd_step_data, h); OFF(fesd_step_data, mu); OFF(fesd_step_data, n_theta); OFF(fesd_step_data, nx);
+  printf("size fesd_tolerances %zu\n", sizeof(fesd_tolerances));
+  OFF(fesd_tolerances, atol_v); OFF(fesd_tolerances, h_min); OFF(fesd_tolerances, max_steps);
+  printf("size fesd_integrate_info %zu\n", sizeof(fesd_integrate_info));
+  OFF(fesd_integrate_info, t); OFF(fesd_integrate_info, n_done); OFF(fesd_integrate_info, h_next);
+  printf("size fesd_stats %zu\n", sizeof(fesd_stats));
+  OFF(fesd_stats, events); OFF(fesd_stats, time); OFF(fesd_stats, mean_iter_switch_step);
+  return 0;
+}
+
+static void vec(const char *name, const double *v, int n) {
+  printf("%s", name);
+  for (int i = 0; i < n; i++) printf(" %.17g", v[i]);
+  printf("\n");
+}
+
+static void events(const fesd_event *ev, int n) {
+  for (int e = 0; e < n; e++) {
+    printf("event %.17g %d %d %d", ev[e].t, ev[e].sys, (int)ev[e].kind, ev[e].n_before);
+    for (int i = 0; i < ev[e].n_before; i++) printf(" %d", ev[e].before[i]);
+    printf(" %d", ev[e].n_after);
+    for (int i = 0; i < ev[e].n_after; i++) printf(" %d", ev[e].after[i]);
+    printf("\n");
+  }
+}
+
+static int parse_family(const char *s, fesd_rk_family *f) {
+  if (!strcmp(s, "explicit")) return *f = FESD_RK_EXPLICIT, 0;
+  return fesd_rk_family_parse(s, f);
+}
+
+static fesd_integrator *make(fesd_problem *P, const char *method, const char *family, int stages, int n_fe, int sens,
+                             const char *const *uarg, int nuarg) {
+  fesd_settings set;
+  fesd_settings_default(&set);
+  set.method = !strcmp(method, "standard") ? FESD_METHOD_STANDARD : FESD_METHOD_FESD;
+  if (parse_family(family, &set.family)) return NULL;
+  set.stages = stages;
+  set.n_fe = n_fe;
+  set.sensitivities = sens;
+  for (int i = 0; i < nuarg && i < FESD_PROBLEM_MAX_NU; i++) P->u[i] = atof(uarg[i]);
+  fesd_integrator *it = NULL;
+  int st = fesd_create(&it, &P->model, &set);
+  if (st) {
+    fprintf(stderr, "create: %s\n", fesd_status_name(st));
+    return NULL;
+  }
+  fesd_set_state(it, 0.0, P->x0, P->u);
+  return it;
+}
+
+int main(int argc, char **argv) {
+  if (argc >= 2 && !strcmp(argv[1], "layout")) return layout();
+  if (argc < 3) {
+    fprintf(stderr, "usage: see the top of reference.c\n");
+    return 2;
+  }
+  fesd_problem P;
+  if (fesd_problem_get(argv[2], &P)) {
+    fprintf(stderr, "unknown problem %s\n", argv[2]);
+    return 2;
+  }
+  const int nx = P.model.nx, nu = P.model.nu;
+  int st;
+  if (!strcmp(argv[1], "fixed") && argc >= 9) {
+    const int nsim = atoi(argv[7]);
+    const double T = atof(argv[8]);
+    fesd_integrator *it = make(&P, argv[3], argv[4], atoi(argv[5]), atoi(argv[6]), 1, (const char *const *)argv + 9,
+                               argc - 9);
+    if (!it) return 1;
+    double x[FESD_PROBLEM_MAX_NX], t;
+    for (int k = 0; k < nsim; k++) {
+      if ((st = fesd_step(it, P.u, T / nsim, NULL))) {
+        printf("status %d\n", st);
+        return 0;
+      }
+      fesd_get_state(it, &t, x);
+      printf("t %.17g\n", t);
+      vec("x", x, nx);
+      const fesd_event *ev;
+      int ne;
+      fesd_last_events(it, &ev, &ne);
+      events(ev, ne);
+    }
+    double Sx[FESD_PROBLEM_MAX_NX * FESD_PROBLEM_MAX_NX], Su[FESD_PROBLEM_MAX_NX * FESD_PROBLEM_MAX_NU];
+    fesd_get_sensitivities(it, Sx, Su);
+    vec("Sx", Sx, nx * nx);
+    vec("Su", Su, nx * nu);
+    fesd_stats S;
+    fesd_get_stats(it, &S);
+    printf("stats %d %d %d\n", S.steps, S.switch_steps, S.newton_iter);
+    printf("status 0\n");
+    fesd_free(&it);
+    return 0;
+  }
+  if (!strcmp(argv[1], "time") && argc >= 8) { /* the Python benchmark's C baseline */
+    const int nsim = atoi(argv[5]), reps = atoi(argv[7]);
+    const double T = atof(argv[6]);
+    fesd_integrator *it = make(&P, "fesd", argv[3], atoi(argv[4]), 2, 0, NULL, 0);
+    if (!it) return 1;
+    double best = 1e30;
+    for (int r = 0; r < reps; r++) {
+      struct timespec a, b;
+      clock_gettime(CLOCK_THREAD_CPUTIME_ID, &a);
+      fesd_set_state(it, 0.0, P.x0, P.u);
+      for (int k = 0; k < nsim; k++)
+        if ((st = fesd_step(it, P.u, T / nsim, NULL))) return 1;
+      clock_gettime(CLOCK_THREAD_CPUTIME_ID, &b);
+      const double us = ((double)(b.tv_sec - a.tv_sec) * 1e6 + (double)(b.tv_nsec - a.tv_nsec) * 1e-3) / nsim;
+      if (us < best) best = us;
+    }
+    double x[FESD_PROBLEM_MAX_NX];
+    fesd_get_state(it, NULL, x);
+    vec("xend", x, nx);
+    printf("us_per_step %.6g\n", best);
+    fesd_free(&it);
+    return 0;
+  }
+  if ((!strcmp(argv[1], "integrate") && argc >= 8) || (!strcmp(argv[1], "grid") && argc >= 8)) {
+    const int grid = !strcmp(argv[1], "grid");
+    const int n = grid ? atoi(argv[7]) : 1;
+    if (grid && argc < 8 + n) return 2;
+    double *tout = malloc((size_t)n * sizeof(double)), *xo = malloc((size_t)n * nx * sizeof(double));
+    if (grid)
+      for (int i = 0; i < n; i++) tout[i] = atof(argv[8 + i]);
+    else
+      tout[0] = atof(argv[7]);
+    const int uoff = grid ? 8 + n : 8;
+    fesd_integrator *it = make(&P, "fesd", argv[3], atoi(argv[4]), 2, 0, (const char *const *)argv + uoff, argc - uoff);
+    if (!it) return 1;
+    fesd_tolerances tol;
+    fesd_tolerances_default(&tol);
+    tol.rtol = atof(argv[5]);
+    tol.atol = atof(argv[6]);
+    fesd_set_tolerances(it, &tol);
+    fesd_integrate_info info;
+    st = grid ? fesd_integrate_grid(it, P.u, n, tout, xo, &info) : fesd_integrate(it, P.u, tout[0], &info);
+    if (grid)
+      for (int i = 0; i < info.n_done; i++) vec("x", xo + (size_t)i * nx, nx);
+    double x[FESD_PROBLEM_MAX_NX], t;
+    fesd_get_state(it, &t, x);
+    printf("t %.17g\n", t);
+    vec("xend", x, nx);
+    printf("info %d %d %d\n", info.steps, info.rejected, info.newton_iter);
+    const fesd_event *ev;
+    int ne;
+    fesd_event_log(it, &ev, &ne);
+    events(ev, ne);
+    printf("status %d\n", st);
+    fesd_free(&it);
+    free(tout);
+    free(xo);
+    return 0;
+  }
+  fprintf(stderr, "bad arguments\n");
+  return 2;
+}
