@@ -303,6 +303,8 @@ typedef struct {
                                drift or stop conditions their internal modes follow the user's) */
   int stages;
   int nx;                 /**< stride of x: states (with time_dependent the time follows them) */
+  int n_sys;              /**< stride of mu: subsystems (with a drift or stop conditions their
+                               internal subsystems follow the user's) */
 } fesd_step_data;
 
 /** @brief Element data of the last accepted step (pointers valid until the next step). */
@@ -344,6 +346,10 @@ typedef struct {
   int root;             /**< on FESD_ROOT: the stop condition's index (else -1) */
   int n_done;           /**< fesd_integrate_grid: output times filled */
   double h_next;        /**< proposed next step length */
+  const char *failed_callback; /**< on FESD_ERR_CALLBACK/NONFINITE, or when a callback fault made
+                                    the steps shrink to FESD_ERR_STEP_TOO_SMALL: the callback of
+                                    the last failed attempt ("field", "switch", ...; else NULL) */
+  double failed_time;   /**< start time of the last failed step attempt (NaN: none) */
 } fesd_integrate_info;
 
 /** @brief Defaults of the error control. */
@@ -359,6 +365,9 @@ FESD_API int fesd_set_tolerances(fesd_integrator *it, const fesd_tolerances *tol
  * @return FESD_OK, FESD_ROOT, or the failure (the state is the last accepted one).
  */
 FESD_API int fesd_integrate(fesd_integrator *it, const double *u, double t_out, fesd_integrate_info *info);
+/** @brief One error-controlled step towards t_out (never past it): as fesd_integrate, but it
+ *         returns after one accepted step (FESD_OK; info->t tells where it is). */
+FESD_API int fesd_integrate_step(fesd_integrator *it, const double *u, double t_out, fesd_integrate_info *info);
 /**
  * @brief States at n increasing output times (x_out: n rows of nx): error-controlled steps to
  *        t_out[n-1]; outputs inside a step from the collocation polynomial (Radau IIA,

@@ -237,27 +237,22 @@ def run_grid(run, t0, tf, t_eval):
 
 # ---- error control, every step ----
 def run_steps(run, t0, tf, tol, max_steps):
-    """One error-controlled step per fesd_integrate call (tolerances.max_steps = 1: the call
-    returns FESD_ERR_TOO_MANY_STEPS after one accepted or rejected step; the proposed next step
-    goes back in as h_init). After a stop condition the integration restarts from its state
-    (fesd_integrate keeps its own step proposal from then on)."""
+    """One error-controlled step per fesd_integrate_step call (the controller keeps its state
+    between calls). After a stop condition the integration restarts from its state."""
     it, u = run.it, run.u
     run.out(t0, it.x)
-    h_prop = tol["h_init"]
+    it.set_tolerances(tol["rtol"], tol["atol"], h_init=tol["h_init"], h_max=tol["h_max"], h_min=tol["h_min"])
     attempts = 0
     while it.t < tf:
         attempts += 1
         if attempts > max_steps:
             raise Stop(-1, f"FESD_ERR_TOO_MANY_STEPS: more than max_steps = {max_steps} steps")
-        it.set_tolerances(tol["rtol"], tol["atol"], h_init=h_prop, h_max=tol["h_max"], h_min=tol["h_min"],
-                          max_steps=1)
         t_prev, x_prev = it.t, it.x
         try:
-            st, info = it.integrate(tf, u, allow=(_lib.FESD_ERR_TOO_MANY_STEPS,))
+            st, info = it.integrate_step(tf, u)
         except FesdError as e:
             run.fail(e)
         run.extra["failed_attempts"] += info["failed_attempts"]
-        h_prop = info["h_next"]
         if info["steps"] == 0:
             continue
         run.switch_events.extend(e for e in it.last_events() if e.kind != "root")

@@ -65,7 +65,7 @@ class EventStruct(ctypes.Structure):
 class StepData(ctypes.Structure):
     _fields_ = [("n_elements", c_int), ("h", P_double), ("t", P_double), ("x", P_double),
                 ("theta", P_double), ("lambda_", P_double), ("mu", P_double), ("n_theta", c_int),
-                ("stages", c_int), ("nx", c_int)]
+                ("stages", c_int), ("nx", c_int), ("n_sys", c_int)]
 
 
 class Tolerances(ctypes.Structure):
@@ -76,7 +76,8 @@ class Tolerances(ctypes.Structure):
 class IntegrateInfo(ctypes.Structure):
     _fields_ = [("status", c_int), ("t", c_double), ("steps", c_int), ("switch_steps", c_int),
                 ("events", c_int), ("rejected", c_int), ("failed_attempts", c_int), ("newton_iter", c_int),
-                ("root", c_int), ("n_done", c_int), ("h_next", c_double)]
+                ("root", c_int), ("n_done", c_int), ("h_next", c_double), ("failed_callback", ctypes.c_char_p),
+                ("failed_time", c_double)]
 
 
 class Stats(ctypes.Structure):
@@ -165,6 +166,7 @@ _proto("fesd_dense_output", c_int, c_void_p, c_double, P_double)
 _proto("fesd_tolerances_default", c_int, P(Tolerances))
 _proto("fesd_set_tolerances", c_int, c_void_p, P(Tolerances))
 _proto("fesd_integrate", c_int, c_void_p, P_double, c_double, P(IntegrateInfo))
+_proto("fesd_integrate_step", c_int, c_void_p, P_double, c_double, P(IntegrateInfo))
 _proto("fesd_integrate_grid", c_int, c_void_p, P_double, c_int, P_double, P_double, P(IntegrateInfo))
 _proto("fesd_get_stats", c_int, c_void_p, P(Stats))
 _proto("fesd_dims", c_int, c_void_p, P_int, P_int)

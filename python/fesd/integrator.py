@@ -268,6 +268,16 @@ class Integrator:
             self._after(st, "fesd_integrate")
         return st, _lib.struct_dict(info)
 
+    def integrate_step(self, t_out, u=None):
+        """One error-controlled step towards t_out (fesd_integrate_step): (status, info) as
+        integrate; info["steps"] is 1 after an accepted step."""
+        ua, up = self._u(u)
+        self.bridge.reset()
+        info = self._iinfo
+        st = _lib.lib.fesd_integrate_step(self._ptr(), up, float(t_out), _byref(info))
+        self._after(st, "fesd_integrate_step")
+        return st, _lib.struct_dict(info)
+
     def integrate_grid(self, t_out, u=None, raise_on_error=True):
         """States at increasing output times (fesd_integrate_grid): (status, x_out (n, nx) with
         the first info["n_done"] rows filled, info)."""
@@ -302,9 +312,9 @@ class Integrator:
             self._raise(st, "fesd_last_step_data")
         n, s, nth = d.n_elements, d.stages, d.n_theta
         m = self.model
-        # internal subsystems (wrap.c): the user's, then one for the drift / the clock, then one
-        # per stop condition; the user's modes come first in theta and lambda
-        nsys_int = m.nsys + (1 if (m.drift is not None or m.time_dependent) else 0) + len(self.events)
+        # internal subsystems (the user's first, then the drift / clock and stop conditions):
+        # d.n_sys is the stride of mu; the user's modes come first in theta and lambda
+        nsys_int = d.n_sys
         n_user = sum(sub.n_modes for sub in m.subsystems)
 
         def arr(p, size):

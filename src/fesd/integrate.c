@@ -79,7 +79,7 @@ static double first_step(fesd_integrator *it, const double *u, double span) {
   if (fesd__model_eval(m, it->t, it->x, u, &pe)) return 1e-6 * span;
   fesd__total_field(it, &pe, th, it->ftot);
   const int nx = it->nxu;
-  double d0 = 0, d1 = 0, *w = it->err_atol, *x1 = it->ftot + it->nx, *f1 = x1 + it->nx;
+  double d0 = 0, d1 = 0, *x1 = it->ftot + it->nx, *f1 = x1 + it->nx, *w = f1 + it->nx;
   for (int r = 0; r < nx; r++) {
     w[r] = it->tol_atol[r] + it->tol.rtol * fabs(it->x[r]);
     d0 = fmax(d0, fabs(it->x[r]) / w[r]);
@@ -101,7 +101,6 @@ static double first_step(fesd_integrator *it, const double *u, double span) {
   return fmin(fmin(100 * h0, h1), span);
 }
 
-/* Append the last step's events to the integration's log (grown outside the Newton loop). */
 /* A zero crossing of stop condition ev->sys in its direction (model.root_dir). */
 static int root_wanted(const fesd_integrator *it, const fesd_event *ev) {
   const int up = ev->n_after == 1 && ev->after[0] == 0; /* into r > 0 */
@@ -109,43 +108,67 @@ static int root_wanted(const fesd_integrator *it, const fesd_event *ev) {
   return !((dir > 0 && !up) || (dir < 0 && up));
 }
 
-/* Append the last step's events to the log (stop conditions only where they stop). */
+/* Append one event (its mode lists copied into the pool; grown outside the Newton loop). */
+static int log_append(fesd_integrator *it, const fesd_event *ev) {
+  const int need = ev->n_before + ev->n_after;
+  if (it->log_n == it->log_cap || it->log_pool_n + need > it->log_pool_cap) {
+    int cap = it->log_cap ? 2 * it->log_cap : 64;
+    size_t pcap = it->log_pool_cap ? 2 * it->log_pool_cap : 256;
+    while (pcap < it->log_pool_n + (size_t)need) pcap *= 2;
+    fesd_event *nl = realloc(it->log, (size_t)cap * sizeof(*nl));
+    if (!nl) return FESD_ERR_NOMEM;
+    it->log = nl;
+    it->log_cap = cap;
+    int *np = realloc(it->log_pool, pcap * sizeof(int));
+    if (!np) return FESD_ERR_NOMEM;
+    it->log_pool = np;
+    it->log_pool_cap = pcap;
+    size_t off = 0; /* the pool moved: point the logged lists into it again */
+    for (int q = 0; q < it->log_n; q++) {
+      it->log[q].before = np + off;
+      it->log[q].after = np + off + it->log[q].n_before;
+      off += (size_t)(it->log[q].n_before + it->log[q].n_after);
+    }
+  }
+  fesd_event *d = &it->log[it->log_n++];
+  *d = *ev;
+  int *p = it->log_pool + it->log_pool_n;
+  memcpy(p, ev->before, (size_t)ev->n_before * sizeof(int));
+  memcpy(p + ev->n_before, ev->after, (size_t)ev->n_after * sizeof(int));
+  d->before = p;
+  d->after = p + ev->n_before;
+  it->log_pool_n += (size_t)need;
+  return FESD_OK;
+}
+
+/* Append the last step's events to the log (stop conditions only where they stop; a stop
+ * logged when the integration stopped on it is not logged again when the next step starts
+ * from it). */
 static int log_events(fesd_integrator *it) {
   const fesd_event *ev;
   int ne;
   fesd_last_events(it, &ev, &ne);
   for (int e = 0; e < ne; e++) {
-    if (ev[e].kind == FESD_EVENT_ROOT && !root_wanted(it, &ev[e])) continue;
-    const int need = ev[e].n_before + ev[e].n_after;
-    if (it->log_n == it->log_cap || it->log_pool_n + need > it->log_pool_cap) {
-      int cap = it->log_cap ? 2 * it->log_cap : 64;
-      size_t pcap = it->log_pool_cap ? 2 * it->log_pool_cap : 256;
-      while (pcap < it->log_pool_n + (size_t)need) pcap *= 2;
-      fesd_event *nl = realloc(it->log, (size_t)cap * sizeof(*nl));
-      if (!nl) return FESD_ERR_NOMEM;
-      it->log = nl;
-      it->log_cap = cap;
-      int *np = realloc(it->log_pool, pcap * sizeof(int));
-      if (!np) return FESD_ERR_NOMEM;
-      it->log_pool = np;
-      it->log_pool_cap = pcap;
-      size_t off = 0; /* the pool moved: point the logged lists into it again */
-      for (int q = 0; q < it->log_n; q++) {
-        it->log[q].before = np + off;
-        it->log[q].after = np + off + it->log[q].n_before;
-        off += (size_t)(it->log[q].n_before + it->log[q].n_after);
-      }
-    }
-    fesd_event *d = &it->log[it->log_n++];
-    *d = ev[e];
-    int *p = it->log_pool + it->log_pool_n;
-    memcpy(p, ev[e].before, (size_t)ev[e].n_before * sizeof(int));
-    memcpy(p + ev[e].n_before, ev[e].after, (size_t)ev[e].n_after * sizeof(int));
-    d->before = p;
-    d->after = p + ev[e].n_before;
-    it->log_pool_n += (size_t)need;
+    if (ev[e].kind == FESD_EVENT_ROOT &&
+        (!root_wanted(it, &ev[e]) || (ev[e].sys == it->stop_sys && ev[e].t == it->stop_t)))
+      continue;
+    int st = log_append(it, &ev[e]);
+    if (st) return st;
   }
   return FESD_OK;
+}
+
+/* The stop at t_root on condition k: logged now (the step ends on the root, so the change of
+ * the condition's sign shows only at the start of the next step). dir of the crossing:
+ * +1 increasing ({1} -> {0}), -1 decreasing. */
+static int log_stop(fesd_integrator *it, int k, double t_root, int dir) {
+  static const int modes[2] = {0, 1};
+  fesd_event ev = {.t = t_root, .sys = k, .kind = FESD_EVENT_ROOT, .n_before = 1, .n_after = 1};
+  ev.before = dir > 0 ? &modes[1] : &modes[0];
+  ev.after = dir > 0 ? &modes[0] : &modes[1];
+  it->stop_sys = k;
+  it->stop_t = t_root;
+  return log_append(it, &ev);
 }
 
 int fesd_event_log(const fesd_integrator *it, const fesd_event **events, int *count) {
@@ -156,8 +179,8 @@ int fesd_event_log(const fesd_integrator *it, const fesd_event **events, int *co
 }
 
 /* The earliest stop condition crossed in the last step in its direction after t_from
- * (-1: none); *t_root its time. */
-static int root_crossed(const fesd_integrator *it, double t_from, double *t_root) {
+ * (-1: none); *t_root its time, *dir its direction (+1 increasing). */
+static int root_crossed(const fesd_integrator *it, double t_from, double *t_root, int *dir) {
   const fesd_event *ev;
   int ne, best = -1;
   fesd_last_events(it, &ev, &ne);
@@ -165,7 +188,7 @@ static int root_crossed(const fesd_integrator *it, double t_from, double *t_root
     if (ev[e].kind != FESD_EVENT_ROOT || !(ev[e].t > t_from) || !root_wanted(it, &ev[e])) continue;
     if (best < 0 || ev[e].t < ev[best].t) best = e;
   }
-  if (best >= 0) *t_root = ev[best].t;
+  if (best >= 0) *t_root = ev[best].t, *dir = ev[best].n_after == 1 && ev[best].after[0] == 0 ? 1 : -1;
   return best >= 0 ? ev[best].sys : -1;
 }
 
@@ -195,6 +218,7 @@ static void rollback(fesd_integrator *it) {
 static int integrate(fesd_integrator *it, const double *u, double t_out, fesd_integrate_info *info, int one_step) {
   memset(info, 0, sizeof(*info));
   info->root = -1;
+  info->failed_time = NAN;
   if (!it) return info->status = FESD_ERR_NULL;
   if (!it->have_state) return info->status = FESD_ERR_NOT_READY;
   if (!isfinite(t_out) || t_out < it->t) return info->status = FESD_ERR_INVALID_ARG;
@@ -209,8 +233,9 @@ static int integrate(fesd_integrator *it, const double *u, double t_out, fesd_in
   const double span = t_out - it->t, hmax = it->tol.h_max > 0 ? it->tol.h_max : INFINITY;
   double h = it->h_next > 0 ? it->h_next : it->tol.h_init > 0 ? it->tol.h_init : first_step(it, u, span);
   const double hmin = it->tol.h_min > 0 ? it->tol.h_min : 1e-14 * fmax(fabs(it->t), fabs(t_out));
-  int st = FESD_OK, rejected_here = 0;
-  double err_prev = 0;
+  int st = FESD_OK;
+  /* the controller's memory (it->ec_rejected, it->ec_err_prev) lives in the integrator: one
+   * call or many (fesd_integrate_grid steps one at a time) take the same steps */
   while (it->t < t_out) {
     if (info->steps + info->rejected >= it->tol.max_steps) {
       st = FESD_ERR_TOO_MANY_STEPS;
@@ -222,12 +247,16 @@ static int integrate(fesd_integrator *it, const double *u, double t_out, fesd_in
     fesd_step_info si;
     st = fesd_step(it, u, hh, &si);
     info->newton_iter += si.newton_iter;
+    if (st != FESD_OK) {
+      info->failed_time = si.failed_time;
+      if (si.failed_callback) info->failed_callback = si.failed_callback;
+    }
     if (st == FESD_ERR_CALLBACK || st == FESD_ERR_NOMEM || st == FESD_ERR_NULL || st == FESD_ERR_INVALID_ARG)
       break;
     if (st != FESD_OK) { /* no solution of this step: shorter steps */
       info->failed_attempts++;
       h = 0.25 * hh;
-      rejected_here = 1;
+      it->ec_rejected = 1;
       if (h < hmin) {
         st = FESD_ERR_STEP_TOO_SMALL;
         break;
@@ -240,7 +269,7 @@ static int integrate(fesd_integrator *it, const double *u, double t_out, fesd_in
       rollback(it);
       info->rejected++;
       h = hh * fmax(0.2, fmin(fac, 0.9));
-      rejected_here = 1;
+      it->ec_rejected = 1;
       if (h < hmin) {
         st = FESD_ERR_STEP_TOO_SMALL;
         break;
@@ -248,7 +277,8 @@ static int integrate(fesd_integrator *it, const double *u, double t_out, fesd_in
       continue;
     }
     double t_root;
-    const int root = root_crossed(it, t_start + 1e-12 * fmax(1.0, fabs(t_start)), &t_root);
+    int root_dir = 0;
+    const int root = root_crossed(it, t_start + 1e-12 * fmax(1.0, fabs(t_start)), &t_root, &root_dir);
     if (root >= 0 && t_root < it->t) { /* end the step on the stop condition */
       rollback(it);
       it->stats.rejected_steps--;
@@ -262,6 +292,8 @@ static int integrate(fesd_integrator *it, const double *u, double t_out, fesd_in
     info->switch_steps += it->log_n > logged;
     info->events += it->log_n - logged;
     if (root >= 0) {
+      if ((st = log_stop(it, root, it->t, root_dir))) break;
+      info->events++;
       info->root = root;
       st = FESD_ROOT;
       break;
@@ -270,11 +302,11 @@ static int integrate(fesd_integrator *it, const double *u, double t_out, fesd_in
     /* PI control (Gustafsson): the previous accepted error damps the reaction to the noisy
      * estimate (fewer rejections than err^(-1/q) alone) */
     double fpi = fac;
-    if (err_prev > 0 && err > 0)
-      fpi = 0.9 * pow(err, -0.7 / it->err_q) * pow(err_prev, 0.4 / it->err_q);
-    h = hh * fmin(rejected_here ? 1.0 : 5.0, fmax(0.2, fpi));
-    err_prev = fmax(err, 1e-4);
-    rejected_here = 0;
+    if (it->ec_err_prev > 0 && err > 0)
+      fpi = 0.9 * pow(err, -0.7 / it->err_q) * pow(it->ec_err_prev, 0.4 / it->err_q);
+    h = hh * fmin(it->ec_rejected ? 1.0 : 5.0, fmax(0.2, fpi));
+    it->ec_err_prev = fmax(err, 1e-4);
+    it->ec_rejected = 0;
     if (one_step) break;
   }
   it->ec_on = 0;
@@ -289,12 +321,18 @@ int fesd_integrate(fesd_integrator *it, const double *u, double t_out, fesd_inte
   return integrate(it, u, t_out, info ? info : &local, 0);
 }
 
+int fesd_integrate_step(fesd_integrator *it, const double *u, double t_out, fesd_integrate_info *info) {
+  fesd_integrate_info local;
+  return integrate(it, u, t_out, info ? info : &local, 1);
+}
+
 int fesd_integrate_grid(fesd_integrator *it, const double *u, int n, const double *t_out, double *x_out,
                         fesd_integrate_info *info) {
   fesd_integrate_info local;
   if (!info) info = &local;
   memset(info, 0, sizeof(*info));
   info->root = -1;
+  info->failed_time = NAN;
   if (!it || (n > 0 && (!t_out || !x_out))) return info->status = FESD_ERR_NULL;
   for (int i = 0; i < n; i++)
     if (!isfinite(t_out[i]) || (i > 0 && t_out[i] < t_out[i - 1])) return info->status = FESD_ERR_INVALID_ARG;
@@ -320,6 +358,8 @@ int fesd_integrate_grid(fesd_integrator *it, const double *u, int n, const doubl
     info->rejected += si.rejected;
     info->failed_attempts += si.failed_attempts;
     info->newton_iter += si.newton_iter;
+    info->failed_callback = si.failed_callback;
+    info->failed_time = si.failed_time;
     if (st != FESD_OK && st != FESD_ROOT) break;
     if (dense) {
       while (done < n && t_out[done] <= it->t) {

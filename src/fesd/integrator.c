@@ -231,7 +231,7 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   it->gbuf = dalloc(nth + nx, &fail);
   it->blk = dalloc((size_t)S->sb, &fail);
   it->vtmp = dalloc(2 * nx, &fail);
-  it->ftot = dalloc(3 * nx, &fail); /* total field; first_step: two more states */
+  it->ftot = dalloc(4 * nx, &fail); /* total field; first_step: two more states, weights */
   it->err_atol = dalloc(nx, &fail);
   it->tol_atol = dalloc(nx, &fail);
   it->gdense = dalloc(nx, &fail); /* calloc: zero */
@@ -314,6 +314,10 @@ int fesd_set_state(fesd_integrator *it, double t0, const double *x0, const doubl
   it->n_events = 0;
   it->h_next = 0;
   it->log_n = 0;
+  it->stop_sys = -1;
+  it->stop_t = NAN;
+  it->ec_rejected = 0;
+  it->ec_err_prev = 0;
   it->log_pool_n = 0;
   /* lambda00 = g(x0) - min g (paper Sec. 3.2.2), with its derivative for sensitivities */
   int st = fesd__update_lambda00(it, it->x, u, it->set.sensitivities);
@@ -487,6 +491,7 @@ int fesd_last_step_data(const fesd_integrator *it, fesd_step_data *d) {
   d->n_theta = it->nth;
   d->stages = it->s;
   d->nx = it->nx;
+  d->n_sys = it->nsys;
   return FESD_OK;
 }
 

@@ -136,6 +136,10 @@ struct fesd_integrator {
   fesd_event *log;
   int *log_pool;
   int log_n, log_cap;
+  int ec_rejected;     /* error control: the last step attempt was rejected (no growth) */
+  double ec_err_prev;  /* ... and the last accepted error estimate (PI control; 0: none) */
+  int stop_sys;      /* the stop condition the last fesd_integrate stopped on (-1: none) */
+  double stop_t;     /* ... and when (its crossing at the next step start is not logged again) */
   size_t log_pool_n, log_pool_cap;
   fesd_event events[FESD_MAX_EVENTS_PER_STEP];
   int n_events;

@@ -85,6 +85,14 @@ int main(void) {
                     "stop condition: %s, root %d at t = %.15f (exact 5/6), x = %.15f", fesd_status_name(st), info.root,
                     t, x[0]);
     const double t_root = t;
+    { /* the stop is in the log when the call that stopped on it returns */
+      const fesd_event *ev0;
+      int ne0;
+      fesd_event_log(it, &ev0, &ne0);
+      FESD_TEST_CHECK(ne0 >= 1 && ev0[ne0 - 1].kind == FESD_EVENT_ROOT && ev0[ne0 - 1].sys == 0 &&
+                          ev0[ne0 - 1].t == t_root && info.events >= 1,
+                      "stop not logged when stopping: %d events", ne0);
+    }
     st = fesd_integrate(it, NULL, 1.0, &info); /* continues from the root to t = 1 */
     fesd_get_state(it, &t, x);
     FESD_TEST_CHECK(st == FESD_OK && t == 1.0 && fabs(x[0] - 2.0 / 3) <= 1e-12, "after the root: %s, t %.3g x %.15f",
@@ -101,6 +109,44 @@ int main(void) {
                     roots);
     printf("stop condition x = 1/2: at t = %.15f (error %.1e); event log %d events (the crossing, the stop)\n", t_root,
            fabs(t_root - 5.0 / 6), ne);
+    fesd_free(&it);
+  }
+  /* one step at a time (fesd_integrate_step) and the grid take the steps of one call */
+  {
+    fesd_problem P;
+    fesd_problem_get("oscillator", &P);
+    fesd_settings set;
+    fesd_settings_default(&set);
+    set.stages = 3;
+    fesd_integrator *it;
+    fesd_create(&it, &P.model, &set);
+    fesd_tolerances tol;
+    fesd_tolerances_default(&tol);
+    tol.rtol = 1e-8;
+    fesd_set_tolerances(it, &tol);
+    fesd_integrate_info info;
+    fesd_set_state(it, 0, P.x0, NULL);
+    fesd_integrate(it, NULL, P.T, &info);
+    const int steps_one = info.steps, rej_one = info.rejected;
+    double x1[2], x2[2], x3[2];
+    fesd_get_state(it, NULL, x1);
+    fesd_set_state(it, 0, P.x0, NULL);
+    int steps_each = 0, rej_each = 0, st = FESD_OK;
+    double t = 0;
+    while (t < P.T && st == FESD_OK && steps_each < 100000) {
+      st = fesd_integrate_step(it, NULL, P.T, &info);
+      steps_each += info.steps, rej_each += info.rejected, t = info.t;
+    }
+    fesd_get_state(it, NULL, x2);
+    fesd_set_state(it, 0, P.x0, NULL);
+    const double tg = P.T;
+    st = fesd_integrate_grid(it, NULL, 1, &tg, x3, &info);
+    FESD_TEST_CHECK(steps_each == steps_one && rej_each == rej_one && info.steps == steps_one &&
+                        x2[0] == x1[0] && x2[1] == x1[1] && x3[0] == x1[0] && x3[1] == x1[1],
+                    "one call %d steps (%d rejected), step by step %d (%d), grid %d (%d)", steps_one, rej_one,
+                    steps_each, rej_each, info.steps, info.rejected);
+    printf("oscillator rtol 1e-8: one call, step by step and the grid: %d steps, %d rejected, the same x(T)\n",
+           steps_one, rej_one);
     fesd_free(&it);
   }
   printf("%d failures\n", fails);
