@@ -241,6 +241,11 @@ FESD_API int fesd_ncp_sensitivity(fesd_ncp *ws, const double *z, double sigma, i
  *         least squares). Round-off gives about 1e-16; a value above ~1e-8 means the solve (and
  *         the sensitivities) cannot be trusted. */
 FESD_API int fesd_ncp_sensitivity_residual(const fesd_ncp *ws, double *rel);
+/** @brief Forward-error estimate of the last fesd_ncp_sensitivity() (square systems; 0 for least
+ *         squares): the largest relative size ||d||_inf / ||dz||_inf of the correction of one step
+ *         of iterative refinement over its right-hand sides, about cond(J) eps when the residual
+ *         is at round-off level. Above ~1e-6 the sensitivities carry that relative error. */
+FESD_API int fesd_ncp_sensitivity_error(const fesd_ncp *ws, double *ferr);
 
 /** @brief Free the workspace and set *ws = NULL. Accepts NULL and *ws == NULL. */
 FESD_API void fesd_ncp_free(fesd_ncp **ws);

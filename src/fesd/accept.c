@@ -80,6 +80,9 @@ static int start_jump(fesd_integrator *it, const double *z, int k) {
 /* Relative residual of the implicit-function solve above which its result is not trusted
  * (round-off gives ~1e-16; the refinement of src/ncp leaves ~1e-15 on sound systems). */
 #define SENS_RESIDUAL_MAX 1e-8
+/* Forward-error estimate (one refinement step's correction, relative) above which the
+ * sensitivities are flagged: a well-conditioned step gives 1e-15 .. 1e-12. */
+#define SENS_FERR_MAX 1e-7
 
 /* A complementarity pair with theta and lambda both at zero at a stage point where no
  * boundary row binds it: the active set is ambiguous there (a switch exactly at a stage
@@ -104,6 +107,31 @@ static int degenerate_pair(fesd_integrator *it, const double *z) {
   return 0;
 }
 
+/* After a switch at the step start, lambda00 of subsystem k lives on the new side: its
+ * derivative is taken against the mode that became active (g_i - g_in), not against the mode
+ * the previous step ended in (at the tie both give lambda00 = 0, but only the new one is the
+ * derivative of the step map: the old one couples the other subsystems' switch times to
+ * this one's state). */
+static int jump_lambda00(fesd_integrator *it, int k) {
+  fesd__model *m = &it->model;
+  const int nx = m->nx, nu = m->nu, nth = m->nth, in = it->jump_in[k];
+  fesd__point_eval pe = {0};
+  pe.g = it->pscr.g;
+  pe.dgdx = it->pscr.dgdx;
+  pe.dgdu = nu > 0 ? it->pscr.dgdu : NULL;
+  int st = fesd__model_eval(m, it->sys.t0, it->sys.x0, it->sys.u, &pe);
+  if (st) return st;
+  double *dg = it->sys.lam00_dp, *t = it->vtmp;
+  for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) {
+    memset(t, 0, (size_t)nx * sizeof(double));
+    fesd__dg_axpy(m, &pe, i, 1.0, t);
+    fesd__dg_axpy(m, &pe, in, -1.0, t);
+    for (int c = 0; c < nx; c++) dg[c * nth + i] = t[c];
+    for (int c = 0; c < nu; c++) dg[(nx + c) * nth + i] = pe.dgdu[c * nth + i] - pe.dgdu[c * nth + in];
+  }
+  return FESD_OK;
+}
+
 /* dx_end/d(x_start, u) of the accepted step by the implicit function theorem on the rows of
  * the last solve (the binding rows of the accepted solution), chained into Sx, Su. */
 static int chain_sensitivities(fesd_integrator *it, const double *z) {
@@ -111,6 +139,7 @@ static int chain_sensitivities(fesd_integrator *it, const double *z) {
     if (it->jump_in[k] >= 0) {
       int sj = start_jump(it, z, k);
       if (sj) return sj;
+      if ((sj = jump_lambda00(it, k))) return sj;
     }
   fesd__system *S = &it->sys;
   fesd__level *L = &it->lv[it->lv_cur];
@@ -126,9 +155,11 @@ static int chain_sensitivities(fesd_integrator *it, const double *z) {
   st = fesd_ncp_sensitivity(it->ncp, z, 0.0, np, L->draw, L->dz);
   if (st == FESD_ERR_CALLBACK && S->status) st = S->status; /* the model's own status */
   if (st) return st;
-  double rel = 0;
+  double rel = 0, ferr = 0;
   fesd_ncp_sensitivity_residual(it->ncp, &rel);
-  if (!(rel <= SENS_RESIDUAL_MAX) || degenerate_pair(it, z)) it->step_flags |= FESD_FLAG_SENS_INACCURATE;
+  fesd_ncp_sensitivity_error(it->ncp, &ferr);
+  if (!(rel <= SENS_RESIDUAL_MAX) || !(ferr <= SENS_FERR_MAX) || degenerate_pair(it, z))
+    it->step_flags |= FESD_FLAG_SENS_INACCURATE;
   /* D = rows of x_N in dz: nx x np */
   const int xN = S->xo[S->N - 1];
   double *D = it->Dtmp;

@@ -88,6 +88,8 @@ struct fesd_integrator {
   /* stage Newton of the guess (guess.c), when s nx <= FESD__GN_MAX: matrix, residual, saved
    * stages, dense Jacobian; pivots; sum theta df/dx on the union pattern (NULL: too large) */
   double *gn, *gn_jth;
+  double *fil_th;         /* nth: multipliers of an alternative (verify.c) */
+  unsigned char *fil_a;   /* nth: its active flags */
   int *gn_piv;
   double *ftot, *gdense;     /* nx: a total field; a dense gradient kept zero between uses */
   fesd__point_eval pscr;     /* scratch model evaluation */

@@ -182,6 +182,18 @@ static const unsigned char *set_before(fesd_integrator *it, int k, double t, int
   return best < 0 ? it->act0 : after(it, best);
 }
 
+/* The active set of subsystem plan[e].sys just before switch e (the start set or the set
+ * after its previous switch). */
+static const unsigned char *set_before_switch(fesd_integrator *it, int e) {
+  const int k = it->plan[e].sys;
+  int best = -1;
+  for (int q = 0; q < it->n_plan; q++)
+    if (q != e && it->plan[q].sys == k && it->plan[q].t < it->plan[e].t &&
+        (best < 0 || it->plan[q].t >= it->plan[best].t))
+      best = q;
+  return best < 0 ? it->act0 : after(it, best);
+}
+
 /* Entering mode j next to the set P of subsystem k at time t of the solution z: a crossing
  * (j alone) when j's field points into j's region, else a sliding mode (P and j). */
 static int enter_set(fesd_integrator *it, const double *z, double t, int k, const unsigned char *P, int j,
@@ -306,14 +318,24 @@ static int update_one(fesd_integrator *it, const double *z, const fesd__violatio
   }
   if (v->first && e >= 0) {
     /* the switch before chose the wrong modes: add the mode that wants in, drop the one
-     * that wants out */
+     * that wants out; a mode that this switch brought in alone (a crossing) and that wants
+     * out again makes it a sliding mode with the modes before; a switch left without a
+     * change is removed (its boundary would only let an element step over the region) */
     fesd__switch *w = &it->plan[e];
     unsigned char *A = after(it, e);
     if (++w->tries > MAX_TRIES || A[v->mode] == (unsigned char)v->enter) return 0;
-    A[v->mode] = (unsigned char)v->enter;
+    const unsigned char *B = set_before_switch(it, e);
+    int crossing = 1;
+    for (int i = a; i < b; i++) crossing &= !(A[i] && B[i]);
+    if (!v->enter && A[v->mode] && !B[v->mode] && crossing) {
+      for (int i = a; i < b; i++) A[i] = (unsigned char)(A[i] || B[i]);
+    } else {
+      A[v->mode] = (unsigned char)v->enter;
+    }
     w->fresh = 1;
     if (empty_set(it, A, k)) return 0;
     drop_after(it, k, w->t);
+    if (!memcmp(A + a, B + a, (size_t)(b - a))) remove_switch(it, e);
     return 1;
   }
   /* a new switch at the predicted time */
@@ -367,8 +389,15 @@ int fesd__plan_update(fesd_integrator *it, const double *z, const fesd__violatio
   const double T = it->sys.T;
   int changed = 0;
   for (int e = 0; e < it->n_plan; e++) it->plan[e].fresh = 0;
+  /* A violation that corrects an earlier switch (first) means the trajectory after that switch
+   * was wrong: the other subsystems' violations after it are left for the next round (a
+   * sliding mode of another subsystem that "fails" after a wrong crossing at a corner). */
+  double t_first = INFINITY;
+  for (int k = 0; k < it->nsys; k++)
+    if (per_sys[k].found && per_sys[k].first) t_first = fmin(t_first, per_sys[k].t);
   for (int k = 0; k < it->nsys; k++) {
     if (!per_sys[k].found) continue;
+    if (!per_sys[k].first && per_sys[k].t > t_first + 1e-9 * T) continue;
     int r = update_one(it, z, &per_sys[k], T);
     if (r < 0) return r;
     if (r == 0) return 0;

@@ -20,7 +20,6 @@
 #include <math.h>
 #include <string.h>
 
-#include <stdlib.h>
 #include "common/timer.h"
 #include "fesd/integrator.h"
 #include "fesd/step.h"

@@ -143,8 +143,12 @@ static void scan_signs(fesd_integrator *it, const double *z, const unsigned char
           /* Stage states at c_j = 0 (Lobatto, explicit RK) lie O(h^2) off the element start,
            * and explicit stages are low-order predictions that can overshoot a surface the
            * trajectory does not reach: for FESD their indicator signs are not switches
-           * (explicit methods are checked at the element ends). */
-          if (!strict && (S->tab.c[j] == 0.0 || (S->tab.is_explicit && !a))) continue;
+           * (explicit methods are checked at the element ends). The Filippov weights of an
+           * implicit c_j = 0 stage are still part of the field the step integrates (b_j > 0):
+           * a negative one there (a sliding element whose first stage pulls the state onto
+           * the surface from off it) is checked like any other. */
+          if (!strict && (S->tab.is_explicit ? !a : (S->tab.c[j] == 0.0 && !a))) continue;
+          if (!strict && S->tab.is_explicit && S->tab.c[j] == 0.0) continue;
           t = tn + S->tab.c[j] * h;
           val = a ? z[fesd__th(S, n, j) + i] : z[fesd__la(S, n, j) + i] * S->wth[i];
         } else {
@@ -249,6 +253,47 @@ static int two_modes(const fesd_integrator *it, const unsigned char *a, int k, i
   return cnt == 2 ? i : -1;
 }
 
+/* With several subsystems sliding at one point (a co-dimension-2 sliding mode of a Cartesian
+ * product), subsystem k's own test holds the others' multipliers fixed, but they change with
+ * k's mode: the sliding mode stands if neither of k's modes, alone and with the other sliding
+ * subsystems' multipliers solved again, is a consistent continuation (its field keeps it in
+ * its region and the others still slide). Returns 1 if some alternative is consistent. */
+static int alternative_exists(fesd_integrator *it, const fesd__point_eval *pe, const double *th,
+                              const unsigned char *a, int k, int i, int j) {
+  const fesd__model *m = &it->model;
+  const int nth = m->nth, nx = m->nx;
+  int coupled = 0;
+  for (int l = 0; l < m->nsys && !coupled; l++) {
+    int jl;
+    coupled = l != k && two_modes(it, a, l, &jl) >= 0;
+  }
+  if (!coupled) return 1; /* a single sliding subsystem: its own test decides */
+  double *keep = it->ftot + 2 * nx, *f2 = it->ftot + nx, *th2 = it->fil_th;
+  unsigned char *a2 = it->fil_a;
+  memcpy(keep, it->ftot, (size_t)nx * sizeof(double)); /* fesd__stage_theta uses ftot */
+  int found = 0;
+  for (int alt = 0; alt < 2 && !found; alt++) {
+    const int p = alt ? j : i, q = alt ? i : j;
+    memcpy(a2, a, (size_t)nth);
+    a2[q] = 0;
+    fesd__stage_theta(it, pe, a2, th2);
+    fesd__total_field(it, pe, th2, f2);
+    double dp, dq; /* normal components of mode p alone and of the other mode, at th2 */
+    fesd__normal_components(it, pe, th2, f2, p, q, &dp, &dq);
+    /* p stays in its region (psi = g_p - g_q < 0) when psi does not increase along the field
+     * of p (dp, in the units of fesd__normal_components / filippov) */
+    int ok = dp <= FIL_STAGE_TOL * (fabs(dp) + fabs(dq));
+    for (int l = 0; l < m->nsys && ok; l++) {
+      int jl, il = two_modes(it, a2, l, &jl);
+      if (il >= 0) ok = filippov(it, pe, th2, f2, il, jl, FIL_STAGE_TOL) == -2;
+    }
+    found = ok;
+    (void)th;
+  }
+  memcpy(it->ftot, keep, (size_t)nx * sizeof(double));
+  return found;
+}
+
 /* Filippov's conditions at the stage points of the elements where a subsystem slides on
  * two modes. */
 static int scan_filippov(fesd_integrator *it, const double *z, const unsigned char *act, fesd__violation *ps) {
@@ -289,7 +334,7 @@ static int scan_filippov(fesd_integrator *it, const double *z, const unsigned ch
            * the remaining field is tangent there) */
           if (S->tab.c[q] == 1.0 && n + 1 < S->N && set_changes(it, act, n + 1, k)) continue;
           int c = filippov(it, &pe, th, it->ftot, i, j, FIL_STAGE_TOL);
-          if (c == -2) continue;
+          if (c == -2 || !alternative_exists(it, &pe, th, a, k, i, j)) continue;
           fesd__violation v = {1, tn + S->tab.c[q] * h, c < 0 ? i : c, k, 0, n, n * s + q, 0, 1, 0, 0};
           v.filippov = c < 0 ? -1 : 1;
           note(&ps[k], &v);
@@ -349,7 +394,7 @@ static int scan_interior(fesd_integrator *it, const double *z, const unsigned ch
         int j, i = two_modes(it, a, k, &j);
         if (i < 0 || !sliding) continue;
         int c = filippov(it, &q, th, it->ftot, i, j, FIL_MID_TOL);
-        if (c == -2) continue;
+        if (c == -2 || !alternative_exists(it, &q, th, a, k, i, j)) continue;
         fesd__violation v = {1, t, c < 0 ? i : c, k, 0, n, n * s + s, 0, c < 0 ? -1 : 1, 0, 0};
         note(&ps[k], &v);
       }

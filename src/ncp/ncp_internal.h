@@ -59,6 +59,7 @@ struct fesd_ncp {
 
   fesd__ncp_stats pending; /* sensitivity work, reported by the next solve */
   double sens_residual;    /* worst relative residual of the last sensitivity solves */
+  double sens_ferr;        /* worst forward-error estimate of the last sensitivity solves */
 };
 
 /* assemble.c */

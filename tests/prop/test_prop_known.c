@@ -197,8 +197,11 @@ static int missed_exit(void) {
     const int st = pr_integrate(&pm.m, &set, x0, NULL, T, nsim, &r);
     double dt, ex = 0;
     for (int q = 0; q < 2; q++) ex = fmax(ex, fabs(r.x[q] - ref.x[q]));
-    /* N_sim = 2 has error 1e-3; order 3 allows ~1e-2 for one step */
-    FESD_TEST_CHECK(st == FESD_OK && pr_same_events(&r, &ref, &dt) && ex <= 5e-2,
+    /* N_sim = 2 has error 1e-3; order 3 allows ~1e-2 for one step. A step too long for its
+     * accuracy may miss the exit if it says so (FESD_FLAG_COARSE: its local error estimate
+     * exceeds coarse_tol) */
+    const int right = pr_same_events(&r, &ref, &dt) && ex <= 5e-2;
+    FESD_TEST_CHECK(st == FESD_OK && (right || (r.flags & FESD_FLAG_COARSE)),
                     "Radau IIA s=2 N_sim=%d: %s, %d events (reference %d), x(T) error %.2e, flags 0x%x", nsim,
                     fesd_status_name(st), r.n_ev, ref.n_ev, ex, r.flags);
   }

@@ -1,6 +1,8 @@
 /* Sensitivities are never silently wrong (property test).
  *
- * A run is silently wrong when it returns FESD_OK, no step set FESD_FLAG_SENS_INACCURATE, and
+ * A run is silently wrong when it returns FESD_OK, no step set FESD_FLAG_SENS_INACCURATE (nor
+ * FESD_FLAG_COARSE: a step too long for its accuracy, whose state and sensitivities are both
+ * only as good as that error), and
  * dx(T)/dx0 or dx(T)/du differs from
  *  - central differences of the FESD map itself (the same settings from x0 +- eps e_j and
  *    u +- eps e_j, eps = 1e-6 max(1, |v_j|)) by more than 1e-5 max(1, |S|) (per column). Skipped where the map is not
@@ -97,7 +99,7 @@ static int check_run(const problem *P, const fesd_settings *set, int jac, tally 
     return 0;
   }
   ta->ok++;
-  const int flagged = (r.flags & FESD_FLAG_SENS_INACCURATE) != 0;
+  const int flagged = (r.flags & (FESD_FLAG_SENS_INACCURATE | FESD_FLAG_COARSE)) != 0;
   ta->flagged += flagged;
   /* central differences of the FESD map, column by column; where one disagrees with S, the
    * differences with eps / 10 and 10 eps decide: if they agree with it the map is smooth and S
