@@ -5,6 +5,7 @@
 #define FESD_PROBLEMS_H
 
 #include "fesd_integrator.h"
+#include "fesd_ocp.h"
 
 #define FESD_PROBLEM_MAX_NX 8
 #define FESD_PROBLEM_MAX_NU 4
@@ -56,5 +57,10 @@ int fesd_stick_slip_field_jac(int sys, int mode, double t, const double *x, cons
                               void *user);
 int fesd_stick_slip_sw(int sys, double t, const double *x, const double *u, double *c, void *user);
 int fesd_stick_slip_sw_jac(int sys, double t, const double *x, const double *u, double *J, double *Ju, void *user);
+
+/* ocp_step_eq (paper Sec. 6.3, ocp_step_eq.c): the OCP on the "ocp-dynamics" model (pass
+ * its model: the problem keeps the pointer), N_ctrl = 6; target q_final = (-pi/6, -pi/4). */
+void fesd_ocp_step_eq(fesd_ocp_problem *p, const fesd_model *model);
+const double *fesd_ocp_step_eq_target(void);
 
 #endif
