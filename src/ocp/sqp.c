@@ -140,7 +140,8 @@ static int line_search(fesd_ocp *o, double nu, int elastic, double vlin, double 
   const double slack = -D <= noise ? noise : 0.0;
   const double dmax = inf_norm(o->d, o->nw), wmax = inf_norm(c->w, o->nw);
   double alpha = 1.0;
-  for (int ls = 0; ls < o->set.max_backtracks && alpha * dmax > 1e-15 * (1 + wmax); ls++) {
+  for (int ls = 0; ls < o->set.max_backtracks; ls++) {
+    if (ls > 0 && alpha * dmax <= 1e-15 * (1 + wmax)) break; /* no change of w left to try */
     if (ls > 0) o->info.line_search_trials++;
     step_to(o, o->trial, o->d, alpha);
     int st = fesd__ocp_eval(o, o->trial);

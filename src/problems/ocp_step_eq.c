@@ -56,3 +56,30 @@ void fesd_ocp_step_eq(fesd_ocp_problem *p, const fesd_model *model) {
   p->l1 = l1;
   p->l1_weight = w;
 }
+
+void fesd_ocp_step_eq_guess(double *u, int n_ctrl) {
+  for (int k = 0; k < n_ctrl; k++) u[2 * k] = u[2 * k + 1] = 2 * k < n_ctrl ? -1.0 : 0.0;
+}
+
+int fesd_ocp_step_eq_resimulate(const fesd_model *model, const double *x0, const double *u, int n_ctrl, double T,
+                                int nsub, double *xT) {
+  fesd_settings s;
+  fesd_settings_default(&s);
+  s.stages = 4; /* Radau IIA order 7, FESD: the switches on element boundaries */
+  fesd_integrator *it;
+  int st = fesd_create(&it, model, &s);
+  if (st) return st;
+  double x[4] = {x0[0], x0[1], x0[2], x0[3]};
+  st = fesd_set_state(it, 0.0, x, u);
+  const double h = T / n_ctrl / nsub;
+  for (int k = 0; k < n_ctrl && !st; k++)
+    for (int j = 0; j < nsub && !st; j++) st = fesd_step(it, u + 2 * k, h, NULL);
+  if (!st) fesd_get_state(it, NULL, xT);
+  fesd_free(&it);
+  return st;
+}
+
+double fesd_ocp_step_eq_error(const double *xT) {
+  const double *qf = fesd_ocp_step_eq_target();
+  return hypot(xT[0] - qf[0], xT[1] - qf[1]);
+}
