@@ -2,7 +2,7 @@
  * @file fesd.h
  * @brief libfesd umbrella header: FESD (Finite Elements with Switch Detection)
  *        integrator for piecewise-smooth (Filippov) ODEs, its semismooth Newton
- *        solver and Runge-Kutta tableaus.
+ *        solver, Runge-Kutta tableaus and direct optimal control (fesd_ocp.h).
  */
 #ifndef FESD_H
 #define FESD_H
@@ -10,4 +10,5 @@
 #include "fesd_rk.h"
 #include "fesd_ncp.h"
 #include "fesd_integrator.h"
+#include "fesd_ocp.h"
 #endif

@@ -41,7 +41,10 @@ extern "C" {
   X(FESD_ERR_MODEL, -17, "invalid model (missing callback or bad dimensions)")          \
   X(FESD_ERR_NOT_READY, -18, "object is not in a state that allows this call")          \
   X(FESD_ERR_TOO_MANY_STEPS, -19, "maximum number of steps reached before the output time") \
-  X(FESD_ERR_STEP_TOO_SMALL, -20, "step size fell below its minimum (error or convergence failures)")
+  X(FESD_ERR_STEP_TOO_SMALL, -20, "step size fell below its minimum (error or convergence failures)") \
+  X(FESD_ERR_INFEASIBLE, -21, "optimal control problem locally infeasible (stationary point of the constraint violation)") \
+  X(FESD_ERR_ITER_LIMIT, -22, "optimizer iteration limit reached before the KKT tolerances were met") \
+  X(FESD_ERR_QP, -23, "QP subproblem not solved (also in elastic mode)")
 
 typedef enum {
 #define FESD_X_ENUM(name, value, msg) name = value,

@@ -5,6 +5,7 @@
 #define FESD_PROBLEMS_H
 
 #include "fesd_integrator.h"
+#include "fesd_ocp.h"
 
 #define FESD_PROBLEM_MAX_NX 8
 #define FESD_PROBLEM_MAX_NU 4
@@ -56,5 +57,19 @@ int fesd_stick_slip_field_jac(int sys, int mode, double t, const double *x, cons
                               void *user);
 int fesd_stick_slip_sw(int sys, double t, const double *x, const double *u, double *c, void *user);
 int fesd_stick_slip_sw_jac(int sys, double t, const double *x, const double *u, double *J, double *Ju, void *user);
+
+/* ocp_step_eq (paper Sec. 6.3, ocp_step_eq.c): the OCP on the "ocp-dynamics" model (pass
+ * its model: the problem keeps the pointer), N_ctrl = 6; target q_final = (-pi/6, -pi/4). */
+void fesd_ocp_step_eq(fesd_ocp_problem *p, const fesd_model *model);
+const double *fesd_ocp_step_eq_target(void);
+/* Control guess (u = (-1, -1) in the first half of the intervals, then 0): zero controls leave
+ * the iterates at the origin, where the sensitivities of q vanish (a local minimum). */
+void fesd_ocp_step_eq_guess(double *u, int n_ctrl);
+/* High-accuracy re-simulation with piecewise constant controls u (n_ctrl x 2) over [0, T]: FESD
+ * Radau IIA s = 4, nsub steps per interval (40: converged to ~1e-13); x(T) into xT. */
+int fesd_ocp_step_eq_resimulate(const fesd_model *model, const double *x0, const double *u, int n_ctrl, double T,
+                                int nsub, double *xT);
+/* E(T) = ||q(T) - q_final||_2 */
+double fesd_ocp_step_eq_error(const double *xT);
 
 #endif

@@ -1,0 +1,259 @@
+/* The SQP iteration: QP step (normal, or elastic when the linearisation is inconsistent),
+ * l1 exact-penalty line search with a second-order correction, Hessian update, KKT test. */
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "common/timer.h"
+#include "ocp/ocp_internal.h"
+
+static void say(fesd_ocp *o, const char *fmt, ...) {
+  if (!o->set.verbose) return;
+  char buf[256];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(buf, sizeof(buf), fmt, ap);
+  va_end(ap);
+  if (o->set.log) o->set.log(o->set.log_user, buf);
+  else printf("%s\n", buf);
+}
+
+static double inf_norm(const double *v, int n) {
+  double m = 0;
+  for (int i = 0; i < n; i++) m = fmax(m, fabs(v[i]));
+  return m;
+}
+
+/* KKT residuals of pt with multipliers mult into info fields; returns the score
+ * max(residual / tolerance) (<= 1: converged) */
+static double kkt(fesd_ocp *o, const ocp_point *pt, const double *mult, fesd_ocp_info *r) {
+  const int mE = o->mE, mI = o->mI;
+  fesd__ocp_lagrangian_grad(o, pt, mult, o->gl);
+  r->stationarity = inf_norm(o->gl, o->nw);
+  r->stationarity_rel = r->stationarity / fmax(1.0, inf_norm(pt->grad, o->nw));
+  double feas = 0, comp = 0, mn = 0;
+  for (int i = 0; i < mE; i++) feas = fmax(feas, fabs(pt->c[i]));
+  for (int i = mE; i < mE + mI; i++) {
+    feas = fmax(feas, -pt->c[i]);
+    comp = fmax(comp, fabs(mult[i] * pt->c[i]));
+    mn = fmin(mn, mult[i]);
+  }
+  r->feasibility = feas;
+  r->complementarity = comp;
+  r->min_multiplier = mn;
+  r->objective = pt->f;
+  r->integrator_flags = pt->flags;
+  const fesd_ocp_settings *s = &o->set;
+  return fmax(fmax(r->stationarity_rel / s->tol_stat, feas / s->tol_feas), fmax(comp, -mn) / s->tol_comp);
+}
+
+/* QP step at the current point: d, yq, the linearised violation; elastic mode while the
+ * linearisation is inconsistent, with the penalty steered so that the step achieves a tenth of
+ * the best possible decrease of the linearised violation (Byrd, Nocedal, Waltz); *infeasible
+ * when no decrease is possible at a point that violates the constraints. */
+static int qp_step(fesd_ocp *o, double *nu, int *elastic, double *vlin, int *infeasible) {
+  const ocp_point *c = o->cur;
+  const int m = o->mE + o->mI;
+  int st;
+  *infeasible = 0;
+  if (!*elastic) {
+    st = fesd__ocp_qp_solve(o, &o->qp, c, c->c, 0.0, o->d, o->yq, vlin);
+    if (!st || st == FESD_ERR_NOMEM) return st;
+    o->info.qp_failures++;
+    say(o, "  QP failed: %s after %d iterations; elastic mode", fesd_status_name(st), o->qp.iterations);
+    *elastic = 1;
+  }
+  double nue = fmax(*nu, 1.0);
+  st = fesd__ocp_qp_solve(o, &o->qe, c, c->c, nue, o->d, o->yq, vlin);
+  o->info.qp_elastic++;
+  if (st) say(o, "  elastic QP failed: %s after %d iterations", fesd_status_name(st), o->qe.iterations);
+  if (st) return st == FESD_ERR_NOMEM ? st : FESD_ERR_QP;
+  if (*vlin <= o->set.tol_feas) {
+    *elastic = 0; /* consistent again: back to the normal QP */
+    return FESD_OK;
+  }
+  double vinf;
+  st = fesd__ocp_qp_solve(o, &o->qe, c, c->c, o->set.penalty_max, o->dsoc, o->yq2, &vinf);
+  o->info.qp_elastic++;
+  if (st) say(o, "  elastic QP (nu = %.1e) failed: %s after %d iterations", o->set.penalty_max, fesd_status_name(st), o->qe.iterations);
+  if (st) return st == FESD_ERR_NOMEM ? st : FESD_ERR_QP;
+  const double v = c->viol;
+  if (v > o->set.tol_feas && v - vinf <= fmax(o->set.tol_feas, 1e-9 * v)) {
+    *infeasible = 1;
+    return FESD_OK;
+  }
+  while (v - *vlin < 0.1 * (v - vinf) && nue < o->set.penalty_max) {
+    nue = fmin(10 * nue, o->set.penalty_max);
+    if (nue >= o->set.penalty_max) {
+      memcpy(o->d, o->dsoc, (size_t)o->nw * sizeof(double));
+      memcpy(o->yq, o->yq2, (size_t)m * sizeof(double));
+      *vlin = vinf;
+      break;
+    }
+    st = fesd__ocp_qp_solve(o, &o->qe, c, c->c, nue, o->d, o->yq, vlin);
+    o->info.qp_elastic++;
+    if (st) return st == FESD_ERR_NOMEM ? st : FESD_ERR_QP;
+  }
+  *nu = fmax(*nu, nue);
+  return FESD_OK;
+}
+
+static void step_to(const fesd_ocp *o, ocp_point *t, const double *d, double alpha) {
+  const double *w = o->cur->w;
+  for (int j = 0; j < o->nw; j++) {
+    double v = w[j] + alpha * d[j];
+    t->w[j] = v < o->lb[j] ? o->lb[j] : v > o->ub[j] ? o->ub[j] : v; /* round-off only */
+  }
+}
+
+static void swap(ocp_point **a, ocp_point **b) {
+  ocp_point *t = *a;
+  *a = *b;
+  *b = t;
+}
+
+/* Second-order correction: the QP again with constants c(w + d) - J(w) d */
+static int soc_step(fesd_ocp *o, int elastic, double nu, double phi0, double D, double noise) {
+  const int m = o->mE + o->mI;
+  fesd__ocp_jmul(o, o->cur, o->d, o->tmp); /* c + J d */
+  for (int r = 0; r < m; r++) o->tmp[r] = o->trial->c[r] - (o->tmp[r] - o->cur->c[r]);
+  double vl;
+  int st = fesd__ocp_qp_solve(o, elastic ? &o->qe : &o->qp, o->cur, o->tmp, elastic ? fmax(nu, 1.0) : 0.0, o->dsoc,
+                              o->yq2, &vl);
+  if (st) return 0;
+  step_to(o, o->spare, o->dsoc, 1.0);
+  if (fesd__ocp_eval(o, o->spare)) return 0;
+  return o->spare->f + nu * o->spare->viol <= phi0 + o->set.armijo * D + noise;
+}
+
+/* l1 merit line search along o->d; the accepted point becomes o->trial */
+static int line_search(fesd_ocp *o, double nu, int elastic, double vlin, double *alpha_out) {
+  const ocp_point *c = o->cur;
+  const double phi0 = c->f + nu * c->viol;
+  double gd = 0;
+  for (int j = 0; j < o->nw; j++) gd += c->grad[j] * o->d[j];
+  const double D = fmin(gd + nu * (vlin - c->viol), 0.0);
+  /* merit values carry the integrator's round-off: a predicted decrease below it cannot be
+   * verified, and such a step is taken when it does not increase the merit beyond it */
+  const double noise = 1e-12 * (1 + fabs(phi0));
+  const double slack = -D <= noise ? noise : 0.0;
+  const double dmax = inf_norm(o->d, o->nw), wmax = inf_norm(c->w, o->nw);
+  double alpha = 1.0;
+  for (int ls = 0; ls < o->set.max_backtracks; ls++) {
+    if (ls > 0 && alpha * dmax <= 1e-15 * (1 + wmax)) break; /* no change of w left to try */
+    if (ls > 0) o->info.line_search_trials++;
+    step_to(o, o->trial, o->d, alpha);
+    int st = fesd__ocp_eval(o, o->trial);
+    if (st == FESD_ERR_NOMEM) return st;
+    if (!st && o->trial->f + nu * o->trial->viol <= phi0 + o->set.armijo * alpha * D + slack) {
+      *alpha_out = alpha;
+      return FESD_OK;
+    }
+    if (!st && ls == 0 && o->set.soc && soc_step(o, elastic, nu, phi0, D, slack)) {
+      swap(&o->trial, &o->spare);
+      o->info.soc_steps++;
+      *alpha_out = 1.0;
+      return FESD_OK;
+    }
+    alpha *= o->set.backtrack;
+  }
+  return FESD_ERR_LINE_SEARCH;
+}
+
+static void keep_best(fesd_ocp *o, double score, const fesd_ocp_info *r) {
+  if (!(score < o->best_score)) return;
+  o->best_score = score;
+  memcpy(o->w_best, o->cur->w, (size_t)o->nw * sizeof(double));
+  memcpy(o->y_best, o->y, (size_t)(o->mE + o->mI) * sizeof(double));
+  o->best_info = *r;
+}
+
+static int iterate(fesd_ocp *o) {
+  const int m = o->mE + o->mI;
+  double nu = o->set.penalty0;
+  int elastic = 0, reset_done = 0, st;
+  for (int iter = 0;; iter++) {
+    fesd_ocp_info r = {0};
+    const double score = kkt(o, o->cur, o->y, &r);
+    keep_best(o, score, &r);
+    if ((iter > 0 || o->warm) && score <= 1.0) return FESD_OK;
+    if (iter >= o->set.max_iter) return FESD_ERR_ITER_LIMIT;
+    if (o->set.hessian == FESD_OCP_HESSIAN_GAUSS_NEWTON) fesd__ocp_hessian_gn(o, o->cur);
+    double vlin;
+    int infeasible;
+    if ((st = qp_step(o, &nu, &elastic, &vlin, &infeasible))) return st;
+    if (infeasible) return FESD_ERR_INFEASIBLE;
+    /* exact penalty: nu above the multipliers (in elastic mode they are bounded by nu and the
+     * steering in qp_step sets it) */
+    if (!elastic) {
+      double need = 0;
+      for (int i = 0; i < m; i++) need = fmax(need, fabs(o->yq[i]));
+      if (nu < 1.1 * need) nu = 2 * need;
+    }
+    double alpha = 0;
+    st = line_search(o, nu, elastic, vlin, &alpha);
+    o->info.max_step = inf_norm(o->d, o->nw);
+    say(o, "it %3d  f %.10e  viol %.2e  stat %.2e  comp %.2e  |d| %.2e  alpha %.3g  nu %.2e  qp %d%s", iter,
+        o->cur->f, o->cur->viol, r.stationarity_rel, r.complementarity, o->info.max_step, alpha, nu,
+        (elastic ? o->qe.iterations : o->qp.iterations), elastic ? " elastic" : "");
+    if (st == FESD_ERR_LINE_SEARCH && o->set.hessian == FESD_OCP_HESSIAN_BFGS && !reset_done) {
+      fesd__ocp_hessian_reset(o); /* a poor quasi-Newton model: start it again once */
+      reset_done = 1;
+      continue;
+    }
+    if (st) return st;
+    reset_done = 0;
+    if (o->set.hessian == FESD_OCP_HESSIAN_BFGS) fesd__ocp_bfgs_update(o, o->cur, o->trial, o->yq);
+    swap(&o->cur, &o->trial);
+    memcpy(o->y, o->yq, (size_t)m * sizeof(double));
+    o->info.iterations++;
+    o->info.penalty = nu;
+  }
+}
+
+int fesd_ocp_solve(fesd_ocp *o, fesd_ocp_info *info) {
+  if (!o) return FESD_ERR_NULL;
+  const double t0 = fesd__thread_cpu_time();
+  const int m = o->mE + o->mI;
+  memset(&o->info, 0, sizeof(o->info));
+  o->t_int = o->t_qp = 0;
+  int st = FESD_OK;
+  if (!o->have_guess) st = fesd_ocp_set_guess(o, NULL, NULL);
+  memcpy(o->cur->w, o->wg, (size_t)o->nw * sizeof(double));
+  memcpy(o->w_best, o->wg, (size_t)o->nw * sizeof(double));
+  memcpy(o->y, o->y_best, (size_t)m * sizeof(double)); /* zero unless warm */
+  o->best_score = INFINITY;
+  memset(&o->best_info, 0, sizeof(o->best_info));
+  if (!st) st = fesd__ocp_eval(o, o->cur);
+  if (!st) {
+    fesd__ocp_hessian_reset(o);
+    st = iterate(o);
+  }
+  /* the returned iterate: the best one (the last one on success) */
+  fesd_ocp_info *r = &o->info;
+  if (isfinite(o->best_score)) {
+    r->objective = o->best_info.objective;
+    r->stationarity = o->best_info.stationarity;
+    r->stationarity_rel = o->best_info.stationarity_rel;
+    r->feasibility = o->best_info.feasibility;
+    r->complementarity = o->best_info.complementarity;
+    r->min_multiplier = o->best_info.min_multiplier;
+    r->integrator_flags = o->best_info.integrator_flags;
+    memcpy(o->wg, o->w_best, (size_t)o->nw * sizeof(double));
+    o->warm = 1;
+  } else {
+    r->objective = r->stationarity = r->stationarity_rel = r->feasibility = r->complementarity = NAN;
+    memset(o->y_best, 0, (size_t)m * sizeof(double));
+    o->warm = 0;
+  }
+  o->have_guess = 1;
+  fesd__ocp_unpack_multipliers(o, o->y_best);
+  r->status = st;
+  r->time_total = fesd__thread_cpu_time() - t0;
+  r->time_integration = o->t_int;
+  r->time_qp = o->t_qp;
+  r->time_other = r->time_total - o->t_int - o->t_qp;
+  if (info) *info = *r;
+  return st;
+}
