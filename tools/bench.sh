@@ -32,7 +32,7 @@ else
 fi
 mkdir -p "$OUT"
 t0=$(date +%s)
-for b in order sliding_exit sensitivity stewart_anitescu pareto anatomy growth workprec; do
+for b in order sliding_exit sensitivity stewart_anitescu pareto anatomy growth workprec ocp_pareto; do
   echo "== bench_$b"
   "$BUILD_DIR/bench/bench_$b" "${ARGS[@]}" "$OUT"
 done

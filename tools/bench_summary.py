@@ -178,3 +178,16 @@ if cv:
     print("CVODE runs that failed (sliding problems: the sign-following right-hand side chatters): " +
           ", ".join(f"{p} {sum(1 for r in cv if r['problem'] == p and r['status'] != '0')} of "
                     f"{sum(1 for r in cv if r['problem'] == p)}" for p in dict.fromkeys(r["problem"] for r in cv)) + "\n")
+
+oc = rows("ocp_pareto.csv")
+if oc:
+    print("### Direct optimal control: ocp_step_eq (N_ctrl = 6), E(T) of the re-simulated optimal controls\n")
+    table(["method", "family", "s", "N_FE", "status", "SQP it", "CPU ms", "integration ms", "QP ms", "E(T)", "objective"],
+          [[r["method"], r["family"], r["s"], r["nfe"], r["status"], r["iterations"], f(r["cpu_ms"], 1),
+            f(r["cpu_int_ms"], 1), f(r["cpu_qp_ms"], 1), e(r["E"]), r["objective"][:10]] for r in oc])
+    sm = {r["quantity"]: r["value"] for r in rows("ocp_pareto_summary.csv")}
+    if sm:
+        print(f"Error ratio standard / FESD at equal CPU time over the standard method's range: min "
+              f"{e(sm['ratio_min_equal_cpu'])}, geometric mean {e(sm['ratio_geomean_equal_cpu'])} (target >= 1e3); "
+              f"FESD Radau IIA s <= 3, N_FE <= 4: {sm['radau_s3_nfe4_converged']} of {sm['radau_s3_nfe4_solves']} "
+              f"converged, slowest {f(sm['radau_s3_nfe4_max_ms'], 1)} ms (target < 100 ms)\n")

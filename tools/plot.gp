@@ -1,6 +1,6 @@
 # Plots of the bench CSVs (tools/bench.sh): gnuplot -e "dir='bench/results'" tools/plot.gp
 # writes order.png, pareto.png, sliding_exit.png, sensitivity.png, stewart_anitescu.png,
-# anatomy.png, growth.png and workprec.png next to the CSVs. Curves are selected from the long-format CSVs by filters
+# anatomy.png, growth.png, workprec.png and ocp_pareto.png next to the CSVs. Curves are selected from the long-format CSVs by filters
 # that return NaN for the other rows (each curve's rows are contiguous, so lines do not break).
 if (!exists("dir")) dir = "bench/results"
 set datafile separator ","
@@ -175,4 +175,27 @@ if (system("test -f ".f." && echo 1") eq "1") {
          for [m=1:4] NaN with lines lc rgb word(cols,m) lw 2 title word(methname,m)
   }
   unset multiplot
+}
+
+# ---- direct optimal control: ocp_step_eq, terminal error of the re-simulated controls vs CPU ----
+f = dir."/ocp_pareto.csv"
+if (system("test -f ".f." && echo 1") eq "1") {
+  set terminal pngcairo size 900,600 font ",10"
+  set output dir."/ocp_pareto.png"
+  reset
+  set datafile separator ","
+  set grid
+  set logscale xy
+  set format x "10^{%L}"
+  set format y "10^{%L}"
+  set xlabel "CPU time of the OCP solve [ms]"
+  set ylabel "E(T) = |q_{sim}(4) - q_{final}|"
+  set key bottom left font ",8"
+  ofams = "radau lobatto3c gauss erk"
+  ofamname = "Radau-IIA Lobatto-IIIC Gauss-Legendre explicit"
+  set title "ocp\\_step\\_eq (N_{ctrl} = 6): FESD (filled) vs standard (open), marker size grows with s; converged solves (ocp\\_pareto.csv)"
+  plot for [a=1:4] f using (sel("method","fesd") && sel("family", word(ofams,a)) && sel("status","FESD_OK") ? column("cpu_ms") : NaN):(column("E")):(0.4+0.25*column("s")) \
+         with points lc rgb word(cols,a) pt 7 ps variable title "FESD ".word(ofamname,a), \
+       for [a=1:4] f using (sel("method","standard") && sel("family", word(ofams,a)) && sel("status","FESD_OK") ? column("cpu_ms") : NaN):(column("E")):(0.4+0.25*column("s")) \
+         with points lc rgb word(cols,a) pt 6 ps variable title "standard ".word(ofamname,a)
 }
