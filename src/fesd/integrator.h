@@ -112,6 +112,7 @@ struct fesd_integrator {
   unsigned char *plan_after;
   int n_plan, cap_plan;
   double merge_tol; /* switches of different subsystems closer than this share a boundary */
+  int split_layout; /* the layout splits elements longer than T / N_FE (after a failed solve) */
   double *bt;       /* boundary times of the layout (cap_plan + 2) */
   int *bseg;        /* elements per segment (cap_plan + 1) */
   double *hlo, *hhi; /* bounds of the element lengths of the layout (N_cap) */

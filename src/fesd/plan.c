@@ -24,6 +24,7 @@
 void fesd__plan_reset(fesd_integrator *it) {
   it->n_plan = 0;
   it->merge_tol = 1e-9;
+  it->split_layout = 0;
 }
 
 static unsigned char *after(fesd_integrator *it, int e) { return it->plan_after + (size_t)e * it->nth; }
@@ -87,9 +88,6 @@ int fesd__plan_layout(fesd_integrator *it, double T, double *z) {
   int *first_of = it->kb;
   const int nb = cluster(it, T, first_of);
   if (nb + 1 > it->N_cap) return FESD_ERR_TOO_MANY_SWITCHES;
-  const int N = fesd__ladder(it, nb + 1 > it->set.n_fe ? nb + 1 : it->set.n_fe);
-  int st = fesd__use_level(it, N);
-  if (st) return st;
   /* boundary times strictly increasing inside (0, T) */
   double *bt = it->bt;
   const double gap = 1e-8 * T;
@@ -99,6 +97,25 @@ int fesd__plan_layout(fesd_integrator *it, double T, double *z) {
     if (bt[q] < bt[q - 1] + gap) bt[q] = bt[q - 1] + gap;
     if (bt[q] > T - (nb + 1 - q) * gap) bt[q] = T - (nb + 1 - q) * gap;
   }
+  /* After a failed solve (split_layout): no element longer than the nominal T / N_FE where
+   * the cap allows, a switch splits an element instead of stretching its neighbour. With
+   * N_FE = 2 one early switch leaves a single element of almost T after it, where the
+   * fixed-active-set Newton of a coupled chain did not converge (stick-slip chain, n = 64:
+   * 40 Newton iterations in such a step, 8 with the split). Not the default: it costs an
+   * element per switch step and a workspace level more. */
+  int want = nb + 1 > it->set.n_fe ? nb + 1 : it->set.n_fe;
+  if (it->split_layout) {
+    const double h_nom = T / it->set.n_fe;
+    int split = 0;
+    for (int q = 0; q <= nb; q++) {
+      const int c = (int)ceil((bt[q + 1] - bt[q]) / h_nom - 1e-6);
+      split += c > 1 ? c : 1;
+    }
+    if (split > want && split <= it->N_cap) want = split;
+  }
+  const int N = fesd__ladder(it, want);
+  int st = fesd__use_level(it, N);
+  if (st) return st;
   /* elements per segment: one each, the rest to the segment with the longest elements */
   int *cnt = it->bseg;
   for (int q = 0; q <= nb; q++) cnt[q] = 1;
@@ -402,6 +419,16 @@ int fesd__plan_update(fesd_integrator *it, const double *z, const fesd__violatio
     if (r < 0) return r;
     if (r == 0) return 0;
     changed = 1;
+  }
+  /* The brackets of the new switches come from the predicting trajectory; after the earliest
+   * new switch that trajectory changes (coupled subsystems: a mass that sticks moves its
+   * neighbours' exits), so the later ones may move anywhere after it. */
+  double t_new = INFINITY;
+  for (int e = 0; e < it->n_plan; e++)
+    if (it->plan[e].fresh) t_new = fmin(t_new, it->plan[e].t);
+  for (int e = 0; e < it->n_plan; e++) {
+    fesd__switch *w = &it->plan[e];
+    if (w->fresh && w->t > t_new + 1e-9 * T) w->lo = fmin(w->lo, t_new), w->hi = T;
   }
   return changed;
 }

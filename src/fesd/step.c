@@ -416,6 +416,11 @@ static int plan_path(fesd_integrator *it, double *T, fesd_step_info *info) {
       st = fixed_solve(it, z, it->set.max_iter < PLAN_ITER ? it->set.max_iter : PLAN_ITER, info);
       if (st == FESD_OK) break;
       if (hard_failure(st)) return st;
+      if (!it->split_layout) { /* first: the same plan without elements longer than T / N_FE */
+        const int N0 = S->N;
+        it->split_layout = 1;
+        if (fesd__plan_layout(it, S->T, z) == FESD_OK && S->N != N0) continue;
+      }
       if (fesd__plan_retreat(it)) continue;
       /* one new switch and still no solution: the step may hold more than the plan sees
        * (the trajectory after the switch differs from the predicting one); end the sub-step

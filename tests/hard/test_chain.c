@@ -7,14 +7,15 @@
  *    itself checked against Radau IIA s = 4 at the same h (printed difference);
  *  - asserted: every run completes; the error at T converges at the method's order (fitted
  *    slope >= p - 0.7 over the errors above 1e-10); the event sequence (subsystem and kind)
- *    is the reference's; Newton iterations of the steps that hold events <= 4 per event.
+ *    is the reference's; Newton iterations of the steps that hold events <= 4 per event, and
+ *    <= 30 in the worst step.
  * Plus two decoupled relays that both cross inside one step (x_k' = 2 - sign(x_k), exact):
  * exact state and <= 20 Newton iterations for that step. Worst steps are printed. */
 #include "hard_util.h"
 #include "problems/friction_chain.h"
 
 typedef struct {
-  int st, n_ev, steps_done, iters, iters_sw, worst_iter; /* iters_sw: of the steps holding events */
+  int st, n_ev, steps_done, iters, iters_sw, worst_iter, worst_ev; /* iters_sw: of the steps holding events */
   double x[2 * 64];
   int ev_sys[4096], ev_kind[4096];
 } chain_run;
@@ -36,10 +37,10 @@ static int run_chain(int n, double T, fesd_rk_family fam, int s, double h, chain
     st = fesd_step(it, NULL, h, &info);
     if (st) break;
     r->steps_done++;
-    if (info.newton_iter > r->worst_iter) r->worst_iter = info.newton_iter;
     const fesd_event *ev;
     int ne;
     fesd_last_events(it, &ev, &ne);
+    if (info.newton_iter > r->worst_iter) r->worst_iter = info.newton_iter, r->worst_ev = ne;
     if (ne > 0) r->iters_sw += info.newton_iter;
     for (int e = 0; e < ne && r->n_ev < 4096; e++) r->ev_sys[r->n_ev] = ev[e].sys, r->ev_kind[r->n_ev++] = ev[e].kind;
   }
@@ -101,10 +102,11 @@ int main(void) {
         const int same = same_events(&A, &R);
         HD_CHECK(same, "n=%d s=%d h=%g: %d events, reference %d (or other subsystems/kinds)", n, s, hs[g], A.n_ev, R.n_ev);
         HD_CHECK(per_ev <= 4.0, "n=%d s=%d h=%g: %.2f Newton iterations per event", n, s, hs[g], per_ev);
+        HD_CHECK(A.worst_iter <= 30, "n=%d s=%d h=%g: worst step %d Newton iterations", n, s, hs[g], A.worst_iter);
         if (err > 1e-10) e_fit[nfit] = err, h_fit[nfit++] = T / hs[g]; /* steps */
         printf("chain n=%d s=%d h=%-5g: err %.2e, %d events (%s), %d Newton iterations (in steps with events: %.2f "
-               "per event; worst step %d)\n", n, s, hs[g], err, A.n_ev, same ? "as the reference" : "DIFFERENT", A.iters,
-               per_ev, A.worst_iter);
+               "per event; worst step %d with %d events)\n", n, s, hs[g], err, A.n_ev, same ? "as the reference" : "DIFFERENT", A.iters,
+               per_ev, A.worst_iter, A.worst_ev);
       }
       const double p = nfit >= 2 ? hd_slope(h_fit, e_fit, nfit) : NAN;
       printf("chain n=%d s=%d: order %.2f over %d runs (method order %d)\n", n, s, p, nfit, 2 * s - 1);
