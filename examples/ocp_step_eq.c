@@ -7,7 +7,7 @@
  * (terminal error E(T)) and writes CSVs for examples/ocp_step_eq.gp.
  *
  *   ocp_step_eq [--standard] [--family radau|gauss|lobatto3c|erk] [--stages S] [--nfe N]
- *               [--outdir DIR] [--verbose]
+ *               [--outdir DIR] [--hessian auto|gn|bfgs|gn-sr1] [--verbose]
  */
 #include <math.h>
 #include <stdio.h>
@@ -92,8 +92,14 @@ int main(int argc, char **argv) {
     else if (!strcmp(a, "--stages") && v) set.integrator.stages = atoi(argv[++i]);
     else if (!strcmp(a, "--nfe") && v) set.integrator.n_fe = atoi(argv[++i]);
     else if (!strcmp(a, "--outdir") && v) outdir = argv[++i];
+    else if (!strcmp(a, "--hessian") && v) {
+      const char *h = argv[++i];
+      set.hessian = !strcmp(h, "gn") ? FESD_OCP_HESSIAN_GAUSS_NEWTON : !strcmp(h, "bfgs") ? FESD_OCP_HESSIAN_BFGS
+                  : !strcmp(h, "gn-sr1")                                                ? FESD_OCP_HESSIAN_GN_SR1
+                                                                                         : FESD_OCP_HESSIAN_AUTO;
+    }
     else {
-      fprintf(stderr, "usage: ocp_step_eq [--standard] [--family F] [--stages S] [--nfe N] [--outdir DIR] [--verbose]\n");
+      fprintf(stderr, "usage: ocp_step_eq [--standard] [--family F] [--stages S] [--nfe N] [--outdir DIR] [--hessian auto|gn|bfgs|gn-sr1] [--verbose]\n");
       return 2;
     }
   }

@@ -82,14 +82,19 @@ typedef struct {
 } fesd_ocp_problem;
 
 typedef enum {
-  FESD_OCP_HESSIAN_AUTO = 0,        /**< Gauss-Newton when the cost has least-squares terms
-                                         and no general ones, else BFGS (default) */
+  FESD_OCP_HESSIAN_AUTO = 0,        /**< cost with least-squares terms and no general ones:
+                                         GN_SR1 with the FESD method, GAUSS_NEWTON with the
+                                         standard one; else BFGS (default) */
   FESD_OCP_HESSIAN_GAUSS_NEWTON = 1, /**< Gauss-Newton of the least-squares terms (needs
                                          lagrange_lsq or mayer_lsq; trapezoidal rule over each
                                          interval; curvature of the constraints and of general
                                          terms neglected: linear convergence) */
-  FESD_OCP_HESSIAN_BFGS = 2         /**< BFGS per block (x_k, q_k), pairs without enough
+  FESD_OCP_HESSIAN_BFGS = 2,        /**< BFGS per block (x_k, q_k), pairs without enough
                                          curvature skipped */
+  FESD_OCP_HESSIAN_GN_SR1 = 3       /**< Gauss-Newton plus a per-block symmetric rank-one
+                                         correction learning the neglected (possibly
+                                         indefinite) curvature of the dynamics; the correction
+                                         restarts at 0 when the line search backtracks */
 } fesd_ocp_hessian;
 
 typedef enum {
@@ -145,8 +150,10 @@ typedef struct {
   int qp_failures;          /**< QP solves that failed (and were retried elastic or ended) */
   int line_search_trials;   /**< merit evaluations beyond the first per iteration */
   int soc_steps;            /**< accepted second-order corrections */
-  int hessian_updates;      /**< BFGS block updates made */
-  int hessian_skipped;      /**< BFGS block updates skipped (tiny step or too little curvature) */
+  int hessian_updates;      /**< BFGS / SR1 block updates made */
+  int hessian_skipped;      /**< ... skipped (tiny step, too little curvature, SR1 denominator) */
+  int hessian_resets;       /**< quasi-Newton restarts (BFGS after a failed line search, SR1
+                                 correction after a backtracking one) */
   int integrations;         /**< interval simulations (fesd_step calls) */
   int integrator_failures;  /**< interval simulations that failed (trial points rejected) */
   int integrator_flags;     /**< FESD_FLAG_* bits seen at the returned iterate */

@@ -80,6 +80,7 @@ struct fesd_ocp {
   double *d, *dsoc;         /* nw steps */
   double *gl, *gl2;         /* nw Lagrangian gradients */
   double *B;                /* Hessian blocks: N x nb^2, then nx^2 */
+  double *A;                /* GN_SR1: the SR1 correction, same layout as B */
   double *bs, *by, *bBs;    /* BFGS scratch (nb) */
   double *tmp;              /* max(nw, mE + mI) */
   ocp_qp qp, qe;            /* normal and elastic QP */
@@ -117,6 +118,9 @@ int fesd__ocp_call(fesd_ocp *o, fesd_ocp_fn fn, int n, double t, const double *x
 void fesd__ocp_hessian_reset(fesd_ocp *o);
 void fesd__ocp_hessian_gn(fesd_ocp *o, const ocp_point *pt);
 void fesd__ocp_bfgs_update(fesd_ocp *o, const ocp_point *a, const ocp_point *b, const double *mult);
+void fesd__ocp_sr1_reset(fesd_ocp *o);
+void fesd__ocp_hessian_gn_sr1(fesd_ocp *o, const ocp_point *pt); /* B = GN(pt) + A */
+void fesd__ocp_sr1_update(fesd_ocp *o, const ocp_point *a, const ocp_point *b, const double *mult);
 double fesd__ocp_hessian_diag_max(const fesd_ocp *o);
 
 /* qp.c */

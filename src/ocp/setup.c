@@ -34,7 +34,7 @@ static int in(double v, double lo, double hi) { return v >= lo && v <= hi; } /* 
 static int open_in(double v, double lo, double hi) { return v > lo && v < hi; }
 
 static int check_settings(const fesd_ocp_settings *s) {
-  if ((int)s->hessian < FESD_OCP_HESSIAN_AUTO || (int)s->hessian > FESD_OCP_HESSIAN_BFGS ||
+  if ((int)s->hessian < FESD_OCP_HESSIAN_AUTO || (int)s->hessian > FESD_OCP_HESSIAN_GN_SR1 ||
       s->max_iter < 1 || s->max_iter > 100000 || !in(s->tol_stat, 1e-14, 1) || !in(s->tol_feas, 1e-14, 1) ||
       !in(s->tol_comp, 1e-14, 1) || !in(s->penalty0, 0, 1e12) || !in(s->penalty_max, 1, 1e16) ||
       !open_in(s->armijo, 0, 0.5) || !in(s->backtrack, 0.05, 0.95) || s->max_backtracks < 1 ||
@@ -84,7 +84,8 @@ static int check_problem(const fesd_ocp_problem *p, const fesd_ocp_settings *s) 
   if (!st) st = check_bounds(p->path_lb, p->path_ub, p->n_path);
   if (!st) st = check_bounds(p->term_lb, p->term_ub, p->n_term);
   if (st) return st;
-  if (s->hessian == FESD_OCP_HESSIAN_GAUSS_NEWTON && p->n_lagrange_lsq == 0 && p->n_mayer_lsq == 0)
+  if ((s->hessian == FESD_OCP_HESSIAN_GAUSS_NEWTON || s->hessian == FESD_OCP_HESSIAN_GN_SR1) &&
+      p->n_lagrange_lsq == 0 && p->n_mayer_lsq == 0)
     return FESD_ERR_INVALID_ARG;
   return FESD_OK;
 }
@@ -117,7 +118,7 @@ void fesd_ocp_free(fesd_ocp **op) {
   double *arr[] = {o->x0, o->x0_lb, o->x0_ub, o->x_lb, o->x_ub, o->u_lb, o->u_ub, o->path_lb, o->path_ub,
                    o->term_lb, o->term_ub, o->l1_w, o->lb, o->ub, o->mw_f, o->mw_J, o->mw_Ju, o->mw_r,
                    o->mw_rx, o->mw_ru, o->fv, o->fx, o->fu, o->xa, o->Sxa, o->Sua, o->y, o->yq, o->yq2, o->d,
-                   o->dsoc, o->gl, o->gl2, o->B, o->bs, o->by, o->bBs, o->tmp, o->w_best, o->y_best,
+                   o->dsoc, o->gl, o->gl2, o->B, o->A, o->bs, o->by, o->bBs, o->tmp, o->w_best, o->y_best,
                    o->wg, o->m_dyn, o->m_x0, o->m_xb, o->m_ub, o->m_path, o->m_term, o->m_l1};
   for (size_t i = 0; i < sizeof(arr) / sizeof(arr[0]); i++) free(arr[i]);
   free(o->x0_free), free(o->jr), free(o->jc), free(o->rows);
@@ -165,7 +166,7 @@ static int alloc_all(fesd_ocp *o) {
   }
   o->y = get(&f, m, sizeof(double)), o->yq = get(&f, m, sizeof(double)), o->yq2 = get(&f, m, sizeof(double));
   o->d = get(&f, nw, sizeof(double)), o->dsoc = get(&f, nw, sizeof(double)), o->gl = get(&f, nw, sizeof(double)), o->gl2 = get(&f, nw, sizeof(double));
-  o->B = get(&f, N * nb * nb + nx * nx, sizeof(double));
+  o->B = get(&f, N * nb * nb + nx * nx, sizeof(double)), o->A = get(&f, N * nb * nb + nx * nx, sizeof(double));
   o->bs = get(&f, nb, sizeof(double)), o->by = get(&f, nb, sizeof(double)), o->bBs = get(&f, nb, sizeof(double));
   o->tmp = get(&f, nw > m ? nw : m, sizeof(double));
   o->w_best = get(&f, nw, sizeof(double)), o->y_best = get(&f, m, sizeof(double)), o->wg = get(&f, nw, sizeof(double));
@@ -193,9 +194,13 @@ int fesd_ocp_create(fesd_ocp **op, const fesd_ocp_problem *p, const fesd_ocp_set
   o->set = *s;
   o->set.integrator.sensitivities = 1;
   if (o->set.hessian == FESD_OCP_HESSIAN_AUTO)
-    o->set.hessian = (!p->lagrange && !p->mayer && (p->n_lagrange_lsq > 0 || p->n_mayer_lsq > 0))
-                         ? FESD_OCP_HESSIAN_GAUSS_NEWTON
-                         : FESD_OCP_HESSIAN_BFGS;
+    o->set.hessian = !(!p->lagrange && !p->mayer && (p->n_lagrange_lsq > 0 || p->n_mayer_lsq > 0))
+                         ? FESD_OCP_HESSIAN_BFGS
+                     /* the standard method's map has kinks wherever a switch crosses a step
+                      * boundary: secant pairs across them are garbage (measured on ocp_step_eq:
+                      * line search failure); FESD's map is smooth for a fixed switch structure */
+                     : o->set.integrator.method == FESD_METHOD_FESD ? FESD_OCP_HESSIAN_GN_SR1
+                                                                    : FESD_OCP_HESSIAN_GAUSS_NEWTON;
   o->nx = p->model->nx, o->nu = p->model->nu, o->N = p->n_ctrl, o->nb = o->nx + o->nu;
   o->nL = p->n_lagrange_lsq, o->nM = p->n_mayer_lsq;
   o->cost_state = p->lagrange || o->nL > 0;

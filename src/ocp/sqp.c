@@ -180,9 +180,18 @@ static int iterate(fesd_ocp *o) {
     if ((iter > 0 || o->warm) && score <= 1.0) return FESD_OK;
     if (iter >= o->set.max_iter) return FESD_ERR_ITER_LIMIT;
     if (o->set.hessian == FESD_OCP_HESSIAN_GAUSS_NEWTON) fesd__ocp_hessian_gn(o, o->cur);
+    if (o->set.hessian == FESD_OCP_HESSIAN_GN_SR1) fesd__ocp_hessian_gn_sr1(o, o->cur);
     double vlin;
     int infeasible;
-    if ((st = qp_step(o, &nu, &elastic, &vlin, &infeasible))) return st;
+    st = qp_step(o, &nu, &elastic, &vlin, &infeasible);
+    if (st == FESD_ERR_QP && o->set.hessian == FESD_OCP_HESSIAN_GN_SR1) {
+      /* an indefinite SR1 correction can make the (elastic) QP unbounded: retry with GN */
+      fesd__ocp_sr1_reset(o);
+      fesd__ocp_hessian_gn_sr1(o, o->cur);
+      o->info.hessian_resets++;
+      st = qp_step(o, &nu, &elastic, &vlin, &infeasible);
+    }
+    if (st) return st;
     if (infeasible) return FESD_ERR_INFEASIBLE;
     /* exact penalty: nu above the multipliers (in elastic mode they are bounded by nu and the
      * steering in qp_step sets it) */
@@ -194,17 +203,31 @@ static int iterate(fesd_ocp *o) {
     double alpha = 0;
     st = line_search(o, nu, elastic, vlin, &alpha);
     o->info.max_step = inf_norm(o->d, o->nw);
-    say(o, "it %3d  f %.10e  viol %.2e  stat %.2e  comp %.2e  |d| %.2e  alpha %.3g  nu %.2e  qp %d%s", iter,
-        o->cur->f, o->cur->viol, r.stationarity_rel, r.complementarity, o->info.max_step, alpha, nu,
-        (elastic ? o->qe.iterations : o->qp.iterations), elastic ? " elastic" : "");
-    if (st == FESD_ERR_LINE_SEARCH && o->set.hessian == FESD_OCP_HESSIAN_BFGS && !reset_done) {
-      fesd__ocp_hessian_reset(o); /* a poor quasi-Newton model: start it again once */
+    say(o, "it %3d  f %.10e  viol %.2e  stat %.2e  comp %.2e  |d| %.2e  alpha %.3g  nu %.2e  qp %d  flags %x%s",
+        iter, o->cur->f, o->cur->viol, r.stationarity_rel, r.complementarity, o->info.max_step, alpha, nu,
+        (elastic ? o->qe.iterations : o->qp.iterations), o->cur->flags, elastic ? " elastic" : "");
+    const int qn = o->set.hessian == FESD_OCP_HESSIAN_BFGS || o->set.hessian == FESD_OCP_HESSIAN_GN_SR1;
+    if (st == FESD_ERR_LINE_SEARCH && qn && !reset_done) {
+      /* a poor quasi-Newton model: start it again once */
+      if (o->set.hessian == FESD_OCP_HESSIAN_BFGS) fesd__ocp_hessian_reset(o);
+      else fesd__ocp_sr1_reset(o);
       reset_done = 1;
+      o->info.hessian_resets++;
       continue;
     }
     if (st) return st;
     reset_done = 0;
     if (o->set.hessian == FESD_OCP_HESSIAN_BFGS) fesd__ocp_bfgs_update(o, o->cur, o->trial, o->yq);
+    if (o->set.hessian == FESD_OCP_HESSIAN_GN_SR1) {
+      /* a backtracking step: the model was poor (far from the solution, or a switch structure
+       * change in between); curvature learnt there misleads later, so restart from GN */
+      if (alpha < 1.0 || elastic) { /* elastic: the multipliers are the penalty's, not the NLP's */
+        fesd__ocp_sr1_reset(o);
+        o->info.hessian_resets++;
+      } else {
+        fesd__ocp_sr1_update(o, o->cur, o->trial, o->yq);
+      }
+    }
     swap(&o->cur, &o->trial);
     memcpy(o->y, o->yq, (size_t)m * sizeof(double));
     o->info.iterations++;
@@ -228,6 +251,7 @@ int fesd_ocp_solve(fesd_ocp *o, fesd_ocp_info *info) {
   if (!st) st = fesd__ocp_eval(o, o->cur);
   if (!st) {
     fesd__ocp_hessian_reset(o);
+    fesd__ocp_sr1_reset(o);
     st = iterate(o);
   }
   /* the returned iterate: the best one (the last one on success) */
