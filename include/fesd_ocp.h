@@ -133,6 +133,12 @@ typedef struct {
   double qp_tol;             /**< residual of the QP's KKT system (relative to its data), [1e-15,
                                   1e-3] (default 1e-12) */
   int qp_max_iter;           /**< semismooth Newton iterations per QP, [1, 1000] (default 100) */
+  int stall_window;          /**< no-progress stop: after this many consecutive steps with
+                                  alpha < 0.1 during which the best KKT score did not halve,
+                                  GN_SR1 falls back to Gauss-Newton; a second such window (or
+                                  the first with another Hessian) ends the solve with
+                                  FESD_ERR_LINE_SEARCH and the best iterate; [0, 1000], 0: off
+                                  (default 6) */
   fesd_ncp_backend qp_backend; /**< linear solver of the QP (default AUTO: dense up to
                                   FESD_NCP_DENSE_MAX_N unknowns, else KLU) */
   fesd_ocp_init init;        /**< guess when fesd_ocp_set_guess was not called (default SIMULATE) */
@@ -169,6 +175,8 @@ typedef struct {
   double time_integration;  /**< ... in the integrator (steps with sensitivities) */
   double time_qp;           /**< ... in the QP solver */
   double time_other;        /**< the rest (functions, Hessian, line search bookkeeping) */
+  int hessian_fallback;     /**< 1: GN_SR1 fell back to Gauss-Newton (settings.stall_window) */
+  int stalled;              /**< 1: ended by the no-progress rule (status FESD_ERR_LINE_SEARCH) */
 } fesd_ocp_info;
 
 /** Multipliers of the returned iterate, in the user's layout (pointers into the workspace,

@@ -169,22 +169,50 @@ static void keep_best(fesd_ocp *o, double score, const fesd_ocp_info *r) {
   o->best_info = *r;
 }
 
+/* No-progress rule. An accepted step with alpha < 0.1 means the QP model was poor along d; when
+ * stall_window such steps follow one another and the best KKT score has not halved meanwhile,
+ * the solve is stalled (measured cause: a step map that is discontinuous or kinked at the
+ * iterate, e.g. a node at a switching-structure change, where no Hessian helps). GN_SR1 then
+ * falls back to plain Gauss-Newton for the rest of the solve (its SR1 pairs straddle the kink);
+ * a second stall, or one with any other Hessian, ends the solve with FESD_ERR_LINE_SEARCH and
+ * the best iterate, instead of up to max_iter costly damped iterations. */
+typedef struct {
+  int n;         /* consecutive poor steps without the score halving */
+  double ref;    /* best score when the count restarted */
+} stall_track;
+
+/* returns 1 when the window is full (and restarts the count) */
+static int stalled(const fesd_ocp *o, stall_track *t, double alpha) {
+  if (o->set.stall_window <= 0) return 0;
+  if (alpha >= 0.1 || o->best_score <= 0.5 * t->ref) {
+    t->n = 0;
+    t->ref = o->best_score;
+    return 0;
+  }
+  if (++t->n < o->set.stall_window) return 0;
+  t->n = 0;
+  t->ref = o->best_score;
+  return 1;
+}
+
 static int iterate(fesd_ocp *o) {
   const int m = o->mE + o->mI;
   double nu = o->set.penalty0;
   int elastic = 0, reset_done = 0, st;
+  fesd_ocp_hessian hess = o->set.hessian; /* GN_SR1 may fall back to GAUSS_NEWTON */
+  stall_track stall = {0, INFINITY};
   for (int iter = 0;; iter++) {
     fesd_ocp_info r = {0};
     const double score = kkt(o, o->cur, o->y, &r);
     keep_best(o, score, &r);
     if ((iter > 0 || o->warm) && score <= 1.0) return FESD_OK;
     if (iter >= o->set.max_iter) return FESD_ERR_ITER_LIMIT;
-    if (o->set.hessian == FESD_OCP_HESSIAN_GAUSS_NEWTON) fesd__ocp_hessian_gn(o, o->cur);
-    if (o->set.hessian == FESD_OCP_HESSIAN_GN_SR1) fesd__ocp_hessian_gn_sr1(o, o->cur);
+    if (hess == FESD_OCP_HESSIAN_GAUSS_NEWTON) fesd__ocp_hessian_gn(o, o->cur);
+    if (hess == FESD_OCP_HESSIAN_GN_SR1) fesd__ocp_hessian_gn_sr1(o, o->cur);
     double vlin;
     int infeasible;
     st = qp_step(o, &nu, &elastic, &vlin, &infeasible);
-    if (st == FESD_ERR_QP && o->set.hessian == FESD_OCP_HESSIAN_GN_SR1) {
+    if (st == FESD_ERR_QP && hess == FESD_OCP_HESSIAN_GN_SR1) {
       /* an indefinite SR1 correction can make the (elastic) QP unbounded: retry with GN */
       fesd__ocp_sr1_reset(o);
       fesd__ocp_hessian_gn_sr1(o, o->cur);
@@ -206,10 +234,10 @@ static int iterate(fesd_ocp *o) {
     say(o, "it %3d  f %.10e  viol %.2e  stat %.2e  comp %.2e  |d| %.2e  alpha %.3g  nu %.2e  qp %d  flags %x%s",
         iter, o->cur->f, o->cur->viol, r.stationarity_rel, r.complementarity, o->info.max_step, alpha, nu,
         (elastic ? o->qe.iterations : o->qp.iterations), o->cur->flags, elastic ? " elastic" : "");
-    const int qn = o->set.hessian == FESD_OCP_HESSIAN_BFGS || o->set.hessian == FESD_OCP_HESSIAN_GN_SR1;
+    const int qn = hess == FESD_OCP_HESSIAN_BFGS || hess == FESD_OCP_HESSIAN_GN_SR1;
     if (st == FESD_ERR_LINE_SEARCH && qn && !reset_done) {
       /* a poor quasi-Newton model: start it again once */
-      if (o->set.hessian == FESD_OCP_HESSIAN_BFGS) fesd__ocp_hessian_reset(o);
+      if (hess == FESD_OCP_HESSIAN_BFGS) fesd__ocp_hessian_reset(o);
       else fesd__ocp_sr1_reset(o);
       reset_done = 1;
       o->info.hessian_resets++;
@@ -217,8 +245,8 @@ static int iterate(fesd_ocp *o) {
     }
     if (st) return st;
     reset_done = 0;
-    if (o->set.hessian == FESD_OCP_HESSIAN_BFGS) fesd__ocp_bfgs_update(o, o->cur, o->trial, o->yq);
-    if (o->set.hessian == FESD_OCP_HESSIAN_GN_SR1) {
+    if (hess == FESD_OCP_HESSIAN_BFGS) fesd__ocp_bfgs_update(o, o->cur, o->trial, o->yq);
+    if (hess == FESD_OCP_HESSIAN_GN_SR1) {
       /* a backtracking step: the model was poor (far from the solution, or a switch structure
        * change in between); curvature learnt there misleads later, so restart from GN */
       if (alpha < 1.0 || elastic) { /* elastic: the multipliers are the penalty's, not the NLP's */
@@ -232,6 +260,16 @@ static int iterate(fesd_ocp *o) {
     memcpy(o->y, o->yq, (size_t)m * sizeof(double));
     o->info.iterations++;
     o->info.penalty = nu;
+    if (stalled(o, &stall, alpha)) {
+      if (hess != FESD_OCP_HESSIAN_GN_SR1) {
+        say(o, "  no progress in %d iterations: stop", o->set.stall_window);
+        o->info.stalled = 1;
+        return FESD_ERR_LINE_SEARCH;
+      }
+      say(o, "  no progress in %d iterations: Gauss-Newton from here", o->set.stall_window);
+      hess = FESD_OCP_HESSIAN_GAUSS_NEWTON;
+      o->info.hessian_fallback = 1;
+    }
   }
 }
 
