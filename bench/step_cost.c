@@ -4,6 +4,8 @@
  *   bench_step_cost list                 the cases, one per line
  *   bench_step_cost steps CASE K         run CASE; collect (callgrind client requests) only
  *                                        during K consecutive ordinary steps
+ *   bench_step_cost states               final state of every case (%a: a change of the
+ *                                        results shows bit for bit)
  *   bench_step_cost cpu [OUTDIR]         CPU time per integration of every case (bench_time):
  *                                        OUTDIR/step_cpu.csv
  *
@@ -157,7 +159,30 @@ static int cpu_mode(void) {
   return 0;
 }
 
+static int states_mode(void) {
+  for (int i = 0; i < N_CASES; i++) {
+    setup S;
+    if (make(&cases[i], &S)) return 1;
+    fesd_integrator *it = create(&cases[i], &S);
+    int st = it ? 0 : 1, iters = 0;
+    for (int k = 0; k < cases[i].nsim && !st; k++) {
+      fesd_step_info in;
+      st = fesd_step(it, S.u, S.h, &in);
+      iters += in.newton_iter;
+    }
+    double x[64];
+    fesd_get_state(it, NULL, x);
+    printf("%s status %d newton %d x", cases[i].name, st, iters);
+    for (int r = 0; r < S.model->nx && r < 64; r++) printf(" %a", x[r]);
+    printf("\n");
+    fesd_free(&it);
+    unmake(&S);
+  }
+  return 0;
+}
+
 int main(int argc, char **argv) {
+  if (argc == 2 && !strcmp(argv[1], "states")) return states_mode();
   if (argc >= 2 && !strcmp(argv[1], "list")) {
     for (int i = 0; i < N_CASES; i++) printf("%s\n", cases[i].name);
     return 0;

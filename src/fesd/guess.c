@@ -90,11 +90,13 @@ int fesd__consistent_guess(fesd_integrator *it, double *z) {
   fesd__system *S = &it->sys;
   fesd__model *m = &it->model;
   const int nx = S->nx, nth = S->nth, s = S->s;
-  double *g = it->pscr.g, *X = S->X;
+  double *g = it->pscr.g, *X = S->X; /* X: scratch (stage_newton too) */
+  fesd__system_points_stale(S);
   fesd__point_eval pe = {0}, pg = {0}; /* fields only in the sweeps; indicators once after */
   pe.F = it->pscr.F;
   pg.g = g;
   double tn = S->t0;
+  it->guess_fixed = 1;
   for (int n = 0; n < S->N; n++) {
     const double *xn = n == 0 ? S->x0 : z + S->xo[n - 1];
     double h = z[S->ho[n]];
@@ -105,7 +107,9 @@ int fesd__consistent_guess(fesd_integrator *it, double *z) {
      * (Newton is then cheaper). A stiff mode makes them diverge (the guess overflows and
      * Newton fails), so when a sweep changes v clearly more than the previous one, the
      * stages are frozen at x_n for a last sweep: v_j = F(x_n) theta_j. */
-    const int n_sweep = stage_newton(it, z, n, xn, h, tn) == 0 ? 0 : S->tab.is_explicit ? s : it->set.max_sweeps;
+    const int newton_ok = stage_newton(it, z, n, xn, h, tn) == 0;
+    const int n_sweep = newton_ok ? 0 : S->tab.is_explicit ? s : it->set.max_sweeps;
+    it->guess_fixed &= newton_ok;
     int frozen = 0;
     double prev = INFINITY, vmax = 0;
     for (int sweep = 0; sweep < n_sweep; sweep++) {
@@ -231,7 +235,9 @@ int fesd__initial_guess(fesd_integrator *it, const double *u, double T, double *
     fesd__fill_element(it, z, n, it->blk);
     z[S->ho[n]] = T / S->N;
   }
-  return fesd__consistent_guess(it, z);
+  int st = fesd__consistent_guess(it, z);
+  it->z0_fixed = !st && it->guess_fixed;
+  return st;
 }
 
 
@@ -294,6 +300,7 @@ int fesd__regrid_guess(fesd_integrator *it, const double *zp, int Np, double *z)
   fesd__model *m = &it->model;
   const int nx = S->nx, nth = S->nth, s = S->s;
   double *X = S->X; /* scratch: one state */
+  fesd__system_points_stale(S);
   fesd__point_eval pe = {0};
   pe.F = it->pscr.F;
   pe.g = it->pscr.g;

@@ -19,6 +19,8 @@ void fesd__system_free(fesd__system *S) {
   free(S->rlb);
   free(S->rx);
   free(S->X);
+  free(S->pc_z);
+  free(S->pc_xu);
   free(S->Jth);
   free(S->JK);
   free(S->KG);
@@ -252,6 +254,7 @@ static void emit_values(const fesd__system *S, const double *z, double *val) {
 
 void fesd__system_set_N(fesd__system *S, int N) {
   S->N = N;
+  S->pc_valid = 0;
   S->n = N * S->eb;
   const int row = N * S->erows;
   S->rH0 = row;
@@ -346,6 +349,9 @@ int fesd__system_init(fesd__system *S, fesd__model *m, const fesd_tableau *tab, 
   S->Juth = malloc((size_t)N * s * nx * nu1 * sizeof(double));
   S->lam00_dp = malloc((sens ? (size_t)nth * (nx + nu) : 1) * sizeof(double)); /* O(n^2) */
   S->tmp = malloc((size_t)(4 * nx + nth) * sizeof(double));
+  S->pc_z = malloc((size_t)N * S->eb * sizeof(double));
+  S->pc_xu = malloc((size_t)(nx + nu) * sizeof(double));
+  if (!S->pc_z || !S->pc_xu) goto nomem;
   if (!S->pe || !S->X || !S->Jth || !S->JK || !S->KG || !S->Juth || !S->lam00_dp || !S->tmp)
     goto nomem;
   for (int p = 0; p < np; p++)
@@ -408,9 +414,27 @@ static int look_ahead(fesd__system *S, const double *z, int n, double tn, const 
 }
 
 /* Evaluate the model at every stage point (and boundary point) of z. */
+/* Same inputs as the last evaluation (with Jacobians if want_jac)? Records them otherwise. */
+static int points_cached(fesd__system *S, const double *z, int want_jac) {
+  const size_t nz = (size_t)S->n * sizeof(double), nx = (size_t)S->nx * sizeof(double);
+  const size_t nu = (size_t)S->nu * sizeof(double);
+  if (S->pc_valid && S->pc_jac >= want_jac && S->pc_want_u == S->want_u && S->pc_t0 == S->t0 &&
+      !memcmp(S->pc_z, z, nz) && !memcmp(S->pc_xu, S->x0, nx) && (!nu || !memcmp(S->pc_xu + S->nx, S->u, nu)))
+    return 1;
+  memcpy(S->pc_z, z, nz);
+  memcpy(S->pc_xu, S->x0, nx);
+  if (nu) memcpy(S->pc_xu + S->nx, S->u, nu);
+  S->pc_t0 = S->t0;
+  S->pc_want_u = S->want_u;
+  S->pc_jac = want_jac;
+  S->pc_valid = 0; /* until the evaluation succeeds */
+  return 0;
+}
+
 int fesd__system_points(fesd__system *S, const double *z, int want_jac) {
   const int N = S->N, s = S->s, nx = S->nx, nth = S->nth, nu = S->nu;
   fesd__model *m = S->model;
+  if (points_cached(S, z, want_jac)) return FESD_OK;
   double *K = S->tmp; /* K_j = sum_l a_jl v_l */
   double tn = S->t0;
   for (int n = 0; n < N; n++) {
@@ -463,6 +487,7 @@ int fesd__system_points(fesd__system *S, const double *z, int want_jac) {
     }
     tn += h;
   }
+  S->pc_valid = 1;
   return FESD_OK;
 }
 

@@ -91,7 +91,16 @@ typedef struct {
    * indicators), and their maxima over the accepted steps (weights.c) */
   double *magX, *magV, *magG, *refX, *refV, *refG;
   int status;   /* last model status */
+  /* Inputs of the last fesd__system_points (z, x0, u, t0, want_u; pc_jac: with Jacobians):
+   * the weights and the solver's first residual evaluate the same z, and a Newton step's
+   * Jacobian the z of its residual, so repeated points are not evaluated again. Whoever writes
+   * X or pe outside fesd__system_points clears pc_valid (fesd__system_points_stale). */
+  double *pc_z, *pc_xu, pc_t0;
+  int pc_valid, pc_jac, pc_want_u;
 } fesd__system;
+
+/* The outputs of fesd__system_points are no longer those of its last inputs. */
+static inline void fesd__system_points_stale(fesd__system *S) { S->pc_valid = 0; }
 
 /* Storage for up to N_cap elements (the layout starts with N = N_cap); sens: allocate the
  * parameter-derivative storage of sensitivities (O(nth (nx + nu))). Weights start at 1. */
