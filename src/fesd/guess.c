@@ -62,8 +62,9 @@ static int stage_newton(fesd_integrator *it, double *z, int n, const double *xn,
         for (int e = 0; e < m->pf_nnz; e++) Jd[m->pf_r[e] * nx + m->pf_c[e]] += it->gn_jth[e];
         for (int l = 0; l < s; l++) {
           const double a = h * S->tab.A[j][l];
-          for (int r = 0; r < nx; r++)
-            for (int c = 0; c < nx; c++) M[(size_t)(l * nx + c) * q + j * nx + r] = -a * Jd[r * nx + c];
+          double *Mc = M + (size_t)l * nx * q + j * nx; /* column l nx + c, rows j nx + r */
+          for (int c = 0; c < nx; c++, Mc += q)
+            for (int r = 0; r < nx; r++) Mc[r] = -a * Jd[r * nx + c];
         }
       }
       for (int d = 0; d < q; d++) M[(size_t)d * q + d] += 1.0;
@@ -151,8 +152,17 @@ int fesd__consistent_guess(fesd_integrator *it, double *z) {
         for (int l = 0; l < s; l++) acc += S->tab.A[j][l] * z[fesd__v(S, n, l) + r];
         X[r] = xn[r] + h * acc;
       }
-      int st = fesd__model_eval(m, tn + S->tab.c[j] * h, X, S->u, &pg);
-      if (st) return st;
+      /* in full (Jacobians too): the weights of the solve that follows evaluate these points
+       * again when the guess is its solution (an ordinary step); g alone if that fails (a
+       * failing Jacobian callback is reported by the solve, as without this) */
+      const double tj = tn + S->tab.c[j] * h;
+      const fesd__point_eval *pf = fesd__system_stage_eval(S, n * s + j, tj, X, 1);
+      if (pf) {
+        memcpy(g, pf->g, (size_t)nth * sizeof(double));
+      } else {
+        int st = fesd__model_eval(m, tj, X, S->u, &pg);
+        if (st) return st;
+      }
       const double *th = z + fesd__th(S, n, j);
       double *la = z + fesd__la(S, n, j), *mu = z + fesd__mu(S, n, j);
       for (int k = 0; k < m->nsys; k++) {

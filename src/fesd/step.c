@@ -470,7 +470,7 @@ static int try_step(fesd_integrator *it, const double *u, double *T, fesd_step_i
   S->u = u;
   S->lam00 = it->lam00;
   S->T = *T;
-  fesd__system_points_stale(S); /* the callbacks' user data may have changed since the last step */
+  fesd__system_points_reset(S); /* the callbacks' user data may have changed since the last step */
   int st = fesd__use_level(it, it->set.n_fe);
   if (st) return st;
   for (int k = 0; k < it->nsys; k++) it->jump_in[k] = it->jump_out[k] = -1;

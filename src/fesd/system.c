@@ -21,6 +21,9 @@ void fesd__system_free(fesd__system *S) {
   free(S->X);
   free(S->pc_z);
   free(S->pc_xu);
+  free(S->pt_X);
+  free(S->pt_t);
+  free(S->pt_lvl);
   free(S->Jth);
   free(S->JK);
   free(S->KG);
@@ -351,7 +354,10 @@ int fesd__system_init(fesd__system *S, fesd__model *m, const fesd_tableau *tab, 
   S->tmp = malloc((size_t)(4 * nx + nth) * sizeof(double));
   S->pc_z = malloc((size_t)N * S->eb * sizeof(double));
   S->pc_xu = malloc((size_t)(nx + nu) * sizeof(double));
-  if (!S->pc_z || !S->pc_xu) goto nomem;
+  S->pt_X = malloc((size_t)N * s * nx * sizeof(double) + 1);
+  S->pt_t = malloc((size_t)N * s * sizeof(double));
+  S->pt_lvl = calloc((size_t)N * s, 1);
+  if (!S->pc_z || !S->pc_xu || !S->pt_X || !S->pt_t || !S->pt_lvl) goto nomem;
   if (!S->pe || !S->X || !S->Jth || !S->JK || !S->KG || !S->Juth || !S->lam00_dp || !S->tmp)
     goto nomem;
   for (int p = 0; p < np; p++)
@@ -431,6 +437,37 @@ static int points_cached(fesd__system *S, const double *z, int want_jac) {
   return 0;
 }
 
+void fesd__system_points_reset(fesd__system *S) {
+  S->pc_valid = 0;
+  memset(S->pt_lvl, 0, (size_t)S->N_cap * S->s);
+}
+
+/* Stage point p at (t, X); lk: the look-ahead point (needs grad g without Jacobians; not
+ * reused: its level does not say what it holds) */
+static int stage_point(fesd__system *S, int p, double t, const double *X, int want_jac, int lk) {
+  const int nx = S->nx, need = want_jac ? (S->want_u ? 3 : 2) : 1;
+  double *PX = S->pt_X + (size_t)p * nx;
+  if (!lk && S->pt_lvl[p] >= need && S->pt_t[p] == t && !memcmp(PX, X, (size_t)nx * sizeof(double)))
+    return FESD_OK;
+  fesd__point_eval pe = S->pe[p];
+  if (!want_jac) pe.dFdx = NULL;
+  if (!want_jac && !lk) pe.dgdx = NULL;
+  if (!(want_jac && S->want_u)) pe.dFdu = pe.dgdu = NULL;
+  S->pt_lvl[p] = 0;
+  int st = fesd__model_eval(S->model, t, X, S->u, &pe);
+  if (st) return st;
+  memcpy(PX, X, (size_t)nx * sizeof(double));
+  S->pt_t[p] = t;
+  S->pt_lvl[p] = (signed char)(lk ? 0 : need);
+  return FESD_OK;
+}
+
+const fesd__point_eval *fesd__system_stage_eval(fesd__system *S, int p, double t, const double *X, int want_jac) {
+  S->pc_valid = 0; /* pe[p] may change */
+  S->status = stage_point(S, p, t, X, want_jac, 0);
+  return S->status ? NULL : &S->pe[p];
+}
+
 int fesd__system_points(fesd__system *S, const double *z, int want_jac) {
   const int N = S->N, s = S->s, nx = S->nx, nth = S->nth, nu = S->nu;
   fesd__model *m = S->model;
@@ -449,12 +486,9 @@ int fesd__system_points(fesd__system *S, const double *z, int want_jac) {
         K[r] = acc;
         X[r] = xn[r] + h * acc;
       }
-      fesd__point_eval pe = S->pe[p];
+      const fesd__point_eval pe = S->pe[p];
       const int lk = S->look && j == 0; /* needs grad g for its value */
-      if (!want_jac) pe.dFdx = NULL;
-      if (!want_jac && !lk) pe.dgdx = NULL;
-      if (!(want_jac && S->want_u)) pe.dFdu = pe.dgdu = NULL;
-      int st = fesd__model_eval(m, tn + S->tab.c[j] * h, X, S->u, &pe);
+      int st = stage_point(S, p, tn + S->tab.c[j] * h, X, want_jac, lk);
       if (st) return st;
       if (lk && (st = look_ahead(S, z, n, tn, &pe, want_jac))) return st;
       if (want_jac) {

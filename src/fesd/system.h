@@ -97,7 +97,19 @@ typedef struct {
    * X or pe outside fesd__system_points clears pc_valid (fesd__system_points_stale). */
   double *pc_z, *pc_xu, pc_t0;
   int pc_valid, pc_jac, pc_want_u;
+  /* What pe[p] of stage point p holds: evaluated at (pt_t[p], pt_X[p]) with level pt_lvl[p]
+   * (0 nothing reusable, 1 values, 2 with x-Jacobians, 3 also u-Jacobians). The consistent
+   * guess evaluates the stage points in full for its LP rows, and the weights then reuse
+   * them. Cleared at every step start (fesd__system_points_reset). */
+  double *pt_X, *pt_t;
+  signed char *pt_lvl;
 } fesd__system;
+
+/* Stage point p evaluated at (t, X) into pe[p] (with Jacobians if want_jac), unless it holds
+ * that already; NULL if a callback failed (its status in S->status). */
+const fesd__point_eval *fesd__system_stage_eval(fesd__system *S, int p, double t, const double *X, int want_jac);
+/* Nothing evaluated before is reused (the callbacks' user data may have changed). */
+void fesd__system_points_reset(fesd__system *S);
 
 /* The outputs of fesd__system_points are no longer those of its last inputs. */
 static inline void fesd__system_points_stale(fesd__system *S) { S->pc_valid = 0; }
