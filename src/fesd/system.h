@@ -100,8 +100,8 @@ typedef struct {
   /* What pe[p] of stage point p holds: evaluated at (pt_t[p], pt_X[p]) with level pt_lvl[p]
    * (0 nothing reusable, 1 values, 2 with x-Jacobians, 3 also u-Jacobians). The consistent
    * guess evaluates the stage points in full for its LP rows, and the weights then reuse
-   * them. Cleared at every step start (fesd__system_points_reset). */
-  double *pt_X, *pt_t;
+   * them. Cleared at every step start (fesd__system_points_reset) and when u changes. */
+  double *pt_X, *pt_t, *pt_u; /* pt_u: the controls of every record */
   signed char *pt_lvl;
 } fesd__system;
 
