@@ -209,6 +209,112 @@ static void run_cvode(const fesd_problem *P, int lmm, series *S) {
 }
 #endif
 
+#ifdef HAVE_CVODE
+/* ---- paired rounds against CVODE Adams at an error target, full cost of each run ---- */
+typedef struct {
+  const fesd_problem *P;
+  int s, nsim;
+} fixed_run;
+
+/* FESD, fixed steps: create, integrate, free (setup included) */
+static int fixed_full(void *ctx) {
+  fixed_run *r = ctx;
+  fesd_settings set;
+  fesd_settings_default(&set);
+  set.stages = r->s;
+  fesd_integrator *it;
+  if (fesd_create(&it, &r->P->model, &set)) return 1;
+  bench_job j = {it, r->P, r->nsim, r->P->T};
+  int st = bench_integrate(&j, NULL);
+  fesd_free(&it);
+  return st;
+}
+
+typedef struct {
+  const fesd_problem *P;
+  double rtol, err;
+} adams_run;
+
+/* CVODE Adams: context, vector, solver, integration, free (setup included) */
+static int adams_full(void *ctx) {
+  adams_run *a = ctx;
+  SUNContext sc;
+  if (SUNContext_Create(NULL, &sc)) return 1;
+  cv_job j = {.P = a->P};
+  j.y = N_VNew_Serial(a->P->model.nx, sc);
+  j.mem = CVodeCreate(CV_ADAMS, sc);
+  memcpy(N_VGetArrayPointer(j.y), a->P->x0, (size_t)a->P->model.nx * sizeof(double));
+  CVodeInit(j.mem, cv_rhs, 0.0, j.y);
+  CVodeSetUserData(j.mem, &j);
+  CVodeRootInit(j.mem, 1, cv_root);
+  CVodeSetMaxNumSteps(j.mem, 1000000);
+  SUNNonlinearSolver NLS = SUNNonlinSol_FixedPoint(j.y, 0, sc);
+  CVodeSetNonlinearSolver(j.mem, NLS);
+  CVodeSStolerances(j.mem, a->rtol, 1e-2 * a->rtol);
+  int st = cv_fn(&j);
+  a->err = st ? NAN : err_at_T(a->P, N_VGetArrayPointer(j.y));
+  CVodeFree(&j.mem);
+  SUNNonlinSolFree(NLS);
+  N_VDestroy(j.y);
+  SUNContext_Free(&sc);
+  return st;
+}
+
+/* The cheapest fixed-step FESD run (s = 2..5, N_sim = 5 2^g) and the cheapest CVODE Adams run
+ * (rtol = 10^(-k/4)) that reach error <= E, then their CPU ratio in paired rounds. */
+static void pair_at(FILE *out, const fesd_problem *P, double E) {
+  fixed_run best_f = {P, 0, 0};
+  adams_run best_a = {P, 0, 0};
+  double tf = INFINITY, ta = INFINITY;
+  for (int s = 2; s <= 5; s++)
+    for (int g = 0; g < 8; g++) {
+      fixed_run r = {P, s, 5 << g};
+      fesd_settings set;
+      fesd_settings_default(&set);
+      set.stages = s;
+      fesd_integrator *it = bench_create(P, &set);
+      bench_run br;
+      bench_job j = {it, P, r.nsim, P->T};
+      int st = it ? bench_integrate(&j, &br) : 1;
+      fesd_free(&it);
+      if (st || !(br.err <= E)) continue;
+      const double t = bench_time(fixed_full, &r);
+      if (t < tf) tf = t, best_f = r;
+      break; /* more steps cost more */
+    }
+  for (int k = 8; k <= 56; k++) {
+    adams_run a = {P, pow(10.0, -k / 4.0), NAN};
+    if (adams_full(&a) || !(a.err <= E)) continue;
+    const double t = bench_time(adams_full, &a);
+    if (t < ta) ta = t, best_a = a;
+    break; /* tighter tolerances cost more */
+  }
+  if (!best_f.s || !(best_a.rtol > 0)) {
+    printf("%s: error %.0e not reached (FESD s=%d, CVODE rtol %.1e)\n", P->name, E, best_f.s, best_a.rtol);
+    return;
+  }
+  double t1, t2;
+  const double ratio = bench_time_pair(adams_full, &best_a, fixed_full, &best_f, &t1, &t2);
+  fprintf(out, "%s,%.0e,%d,%d,%.3e,%.2f,%.2f,%.3f\n", P->name, E, best_f.s, best_f.nsim, best_a.rtol, 1e6 * t2,
+          1e6 * t1, ratio);
+  printf("%s error <= %.0e: FESD s=%d N_sim=%d %.1f us, CVODE Adams rtol %.1e %.1f us: FESD / CVODE %.3f (paired)\n",
+         P->name, E, best_f.s, best_f.nsim, 1e6 * t2, best_a.rtol, 1e6 * t1, ratio);
+  fflush(stdout);
+}
+
+static int pair_mode(void) {
+  FILE *out = bench_csv("cvode_pair.csv", "problem,error_max,fesd_s,fesd_nsim,cvode_rtol,fesd_us,cvode_us,"
+                                          "ratio_fesd_to_cvode");
+  if (!out) return 1;
+  fesd_problem P;
+  fesd_problem_get("oscillator", &P);
+  pair_at(out, &P, 1e-10);
+  pair_at(out, &P, 1e-6);
+  fclose(out);
+  return 0;
+}
+#endif
+
 static FILE *summary;
 
 /* CPU ratio time_num(E) / time_den(E) at equal error E over the errors both fronts reach
@@ -235,6 +341,13 @@ static void ratio(const char *prob, const char *what, const series *num, const s
 }
 
 int main(int argc, char **argv) {
+#ifdef HAVE_CVODE
+  /* --pair [OUTDIR]: only the paired-rounds comparison with CVODE Adams (cvode_pair.csv) */
+  if (argc >= 2 && !strcmp(argv[1], "--pair")) {
+    argv[1] = argv[0];
+    return bench_init(argc - 1, argv + 1, "bench_workprec --pair [OUTDIR]") ? 1 : pair_mode();
+  }
+#endif
   if (bench_init(argc, argv, "bench_workprec [--quick] [OUTDIR]")) return 1;
   csv = bench_csv("workprec.csv", "problem,method,stages,param,cpu_ms,error,steps,status");
   summary = bench_csv("workprec_summary.csv", "problem,comparison,error_below,ratio_gmean,ratio_min,ratio_max,"

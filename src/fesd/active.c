@@ -170,9 +170,33 @@ int fesd__set_border(fesd_integrator *it) {
  * boundary k: bmode[k] = 0 -> h_k = h_{k-1}; 1 -> cross-complementarity row;
  * 2 -> sliding exit of mode exit_mode[k]: the pair of its last stage before the boundary
  * is pinned (theta = lambda = 0) and neither boundary row is used. */
+/* Is (act, bmode, exit_mode) the selection in force on this solver and layout? Records it
+ * otherwise (valid once applied). */
+static int rows_cached(fesd_integrator *it, const unsigned char *act, const int *bmode, const int *exit_mode) {
+  const fesd__system *S = &it->sys;
+  const int N = S->N, *eb = it->rk_bmode + N + 1;
+  const size_t na = (size_t)N * S->s * S->nth;
+  int same = it->rk_valid && it->rk_ncp == (const void *)it->ncp && it->rk_N == N && !memcmp(it->rk_act, act, na);
+  for (int k = 1; k < N && same; k++) {
+    const int b = bmode ? bmode[k] : 0;
+    same = b == it->rk_bmode[k] && (b != 2 || exit_mode[k] == eb[k]);
+  }
+  if (same) return 1;
+  it->rk_valid = 0;
+  it->rk_ncp = it->ncp;
+  it->rk_N = N;
+  memcpy(it->rk_act, act, na);
+  for (int k = 1; k < N; k++) {
+    it->rk_bmode[k] = bmode ? bmode[k] : 0;
+    it->rk_bmode[N + 1 + k] = it->rk_bmode[k] == 2 ? exit_mode[k] : 0;
+  }
+  return 0;
+}
+
 int fesd__rows_active(fesd_integrator *it, const unsigned char *act, const int *bmode,
                       const int *exit_mode) {
   fesd__system *S = &it->sys;
+  if (rows_cached(it, act, bmode, exit_mode)) return FESD_OK;
   memset(it->eq_active, 1, (size_t)S->n_eq);
   for (int k = 1; k < S->N; k++) {
     int b = bmode ? bmode[k] : 0;
@@ -194,6 +218,8 @@ int fesd__rows_active(fesd_integrator *it, const unsigned char *act, const int *
       else it->pair_mode[fesd__pair(S, k - 1, S->s - 1, exit_mode[k])] = FESD_NCP_PAIR_PIN;
     }
   int st = fesd__set_border(it);
-  return st ? st : fesd_ncp_set_rows(it->ncp, it->eq_active, it->pair_mode);
+  if (!st) st = fesd_ncp_set_rows(it->ncp, it->eq_active, it->pair_mode);
+  it->rk_valid = !st;
+  return st;
 }
 

@@ -62,8 +62,9 @@ static int stage_newton(fesd_integrator *it, double *z, int n, const double *xn,
         for (int e = 0; e < m->pf_nnz; e++) Jd[m->pf_r[e] * nx + m->pf_c[e]] += it->gn_jth[e];
         for (int l = 0; l < s; l++) {
           const double a = h * S->tab.A[j][l];
-          for (int r = 0; r < nx; r++)
-            for (int c = 0; c < nx; c++) M[(size_t)(l * nx + c) * q + j * nx + r] = -a * Jd[r * nx + c];
+          double *Mc = M + (size_t)l * nx * q + j * nx; /* column l nx + c, rows j nx + r */
+          for (int c = 0; c < nx; c++, Mc += q)
+            for (int r = 0; r < nx; r++) Mc[r] = -a * Jd[r * nx + c];
         }
       }
       for (int d = 0; d < q; d++) M[(size_t)d * q + d] += 1.0;
@@ -90,11 +91,13 @@ int fesd__consistent_guess(fesd_integrator *it, double *z) {
   fesd__system *S = &it->sys;
   fesd__model *m = &it->model;
   const int nx = S->nx, nth = S->nth, s = S->s;
-  double *g = it->pscr.g, *X = S->X;
+  double *g = it->pscr.g, *X = S->X; /* X: scratch (stage_newton too) */
+  fesd__system_points_stale(S);
   fesd__point_eval pe = {0}, pg = {0}; /* fields only in the sweeps; indicators once after */
   pe.F = it->pscr.F;
   pg.g = g;
   double tn = S->t0;
+  it->guess_fixed = 1;
   for (int n = 0; n < S->N; n++) {
     const double *xn = n == 0 ? S->x0 : z + S->xo[n - 1];
     double h = z[S->ho[n]];
@@ -105,7 +108,9 @@ int fesd__consistent_guess(fesd_integrator *it, double *z) {
      * (Newton is then cheaper). A stiff mode makes them diverge (the guess overflows and
      * Newton fails), so when a sweep changes v clearly more than the previous one, the
      * stages are frozen at x_n for a last sweep: v_j = F(x_n) theta_j. */
-    const int n_sweep = stage_newton(it, z, n, xn, h, tn) == 0 ? 0 : S->tab.is_explicit ? s : it->set.max_sweeps;
+    const int newton_ok = stage_newton(it, z, n, xn, h, tn) == 0;
+    const int n_sweep = newton_ok ? 0 : S->tab.is_explicit ? s : it->set.max_sweeps;
+    it->guess_fixed &= newton_ok;
     int frozen = 0;
     double prev = INFINITY, vmax = 0;
     for (int sweep = 0; sweep < n_sweep; sweep++) {
@@ -147,8 +152,17 @@ int fesd__consistent_guess(fesd_integrator *it, double *z) {
         for (int l = 0; l < s; l++) acc += S->tab.A[j][l] * z[fesd__v(S, n, l) + r];
         X[r] = xn[r] + h * acc;
       }
-      int st = fesd__model_eval(m, tn + S->tab.c[j] * h, X, S->u, &pg);
-      if (st) return st;
+      /* in full (Jacobians too): the weights of the solve that follows evaluate these points
+       * again when the guess is its solution (an ordinary step); g alone if that fails (a
+       * failing Jacobian callback is reported by the solve, as without this) */
+      const double tj = tn + S->tab.c[j] * h;
+      const fesd__point_eval *pf = fesd__system_stage_eval(S, n * s + j, tj, X, 1);
+      if (pf) {
+        memcpy(g, pf->g, (size_t)nth * sizeof(double));
+      } else {
+        int st = fesd__model_eval(m, tj, X, S->u, &pg);
+        if (st) return st;
+      }
       const double *th = z + fesd__th(S, n, j);
       double *la = z + fesd__la(S, n, j), *mu = z + fesd__mu(S, n, j);
       for (int k = 0; k < m->nsys; k++) {
@@ -231,7 +245,9 @@ int fesd__initial_guess(fesd_integrator *it, const double *u, double T, double *
     fesd__fill_element(it, z, n, it->blk);
     z[S->ho[n]] = T / S->N;
   }
-  return fesd__consistent_guess(it, z);
+  int st = fesd__consistent_guess(it, z);
+  it->z0_fixed = !st && it->guess_fixed;
+  return st;
 }
 
 
@@ -294,6 +310,7 @@ int fesd__regrid_guess(fesd_integrator *it, const double *zp, int Np, double *z)
   fesd__model *m = &it->model;
   const int nx = S->nx, nth = S->nth, s = S->s;
   double *X = S->X; /* scratch: one state */
+  fesd__system_points_stale(S);
   fesd__point_eval pe = {0};
   pe.F = it->pscr.F;
   pe.g = it->pscr.g;

@@ -81,7 +81,7 @@ void fesd_free(fesd_integrator **itp) {
   void *other[] = {it->eq_active, it->pair_mode, it->pt_src, it->kb,   it->sw_at,    it->act,
                    it->act0,      it->cand,      it->swap_set, it->bmode, it->exit_mode, it->jump_in,
                    it->jump_out,  it->scan_buf,  it->plan,   it->plan_after, it->bseg, it->ev_pool, it->raw_border, it->col_border,
-                   it->gn, it->gn_jth, it->gn_piv, it->fil_th, it->fil_a};
+                   it->gn, it->gn_jth, it->gn_piv, it->fil_th, it->fil_a, it->rk_act, it->rk_bmode};
   for (size_t i = 0; i < sizeof(other) / sizeof(other[0]); i++) free(other[i]);
   free(it);
   *itp = NULL;
@@ -258,6 +258,9 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   it->swap_set = malloc(nth);
   it->bmode = calloc(N + 1, sizeof(int));
   it->exit_mode = calloc(N + 1, sizeof(int));
+  it->rk_act = malloc(N * s * nth);
+  it->rk_bmode = calloc(2 * (N + 1), sizeof(int)); /* bmode, then exit_mode */
+  if (!it->rk_act || !it->rk_bmode) fail = 1;
   it->jump_in = malloc(nsys * sizeof(int));
   it->jump_out = malloc(nsys * sizeof(int));
   it->scan_buf = malloc(nsys * sizeof(*it->scan_buf));

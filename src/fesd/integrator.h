@@ -98,12 +98,21 @@ struct fesd_integrator {
   /* active sets: per stage (act), at the step start (act0), per element boundary */
   unsigned char *act, *act0, *cand, *swap_set;
   int *bmode, *exit_mode;
+  /* the last fesd__rows_active selection (solver, N, act, bmode, exit_mode), still in force
+   * while rk_valid: the same selection is not rebuilt (rows_select clears rk_valid) */
+  unsigned char *rk_act;
+  int *rk_bmode, rk_N, rk_valid;
+  const void *rk_ncp;
   double *zfast;
   int *jump_in, *jump_out; /* per subsystem: a switch exactly at the step start (mode entering,
                               mode left), or -1 */
   fesd__violation *scan_buf; /* nsys */
   int step_flags;          /* FESD_FLAG_* of the current fesd_step */
   int nonunique;
+  /* guess_fixed: the last fesd__consistent_guess solved every element's stage equations by
+   * stage Newton (its result is then a fixed point of it); z0_fixed: so did the one that made
+   * z0 in fesd__initial_guess (start_solve need not repeat it on an unchanged z0) */
+  int guess_fixed, z0_fixed;
   int last_sw, last_iter; /* the last accepted step: a switch step?, its iterations (stats) */
   int exit_pinned; /* the accepted sub-step's exits are pinned (exit rows on the plan path) */           /* the step started on a surface that the fields on both sides leave */
   /* the switch plan of the current (sub)step and the active set after each switch (rows of

@@ -50,6 +50,7 @@ static int hard_failure(int st) {
 
 static int rows_select(fesd_integrator *it, const int *switch_at) {
   fesd__system *S = &it->sys;
+  it->rk_valid = 0; /* replaces the selection of fesd__rows_active */
   memset(it->eq_active, 1, (size_t)S->n_eq);
   memset(it->bmode, 0, (size_t)(S->N + 1) * sizeof(int));
   for (int k = 1; k < S->N; k++) {
@@ -218,7 +219,11 @@ static int start_solve(fesd_integrator *it, fesd_step_info *info) {
   memset(it->bmode, 0, (size_t)(S->N + 1) * sizeof(int));
   memcpy(it->z, it->z0, (size_t)S->n * sizeof(double));
   fesd__impose_active(it, it->z, it->act);
-  int st = fesd__consistent_guess(it, it->z);
+  /* z0 came out of a consistent guess solved by stage Newton: if the active set left it
+   * unchanged (bit for bit), a second consistent guess would return it unchanged */
+  const int same = it->z0_fixed && !memcmp(it->z, it->z0, (size_t)S->n * sizeof(double));
+  it->z0_fixed = 0;
+  int st = same ? FESD_OK : fesd__consistent_guess(it, it->z);
   if (st) return st;
   return fixed_solve(it, it->z, it->set.max_iter_first, info);
 }
@@ -311,6 +316,7 @@ static int explicit_std(fesd_integrator *it) {
   fesd__model *m = &it->model;
   const int nx = S->nx, nth = S->nth, s = S->s;
   double *z = it->z, *X = S->X, *g = it->pscr.g;
+  fesd__system_points_stale(S);
   fesd__point_eval pe = {0};
   pe.F = it->pscr.F;
   pe.g = g;
@@ -466,6 +472,7 @@ static int try_step(fesd_integrator *it, const double *u, double *T, fesd_step_i
   S->u = u;
   S->lam00 = it->lam00;
   S->T = *T;
+  fesd__system_points_reset(S); /* the callbacks' user data may have changed since the last step */
   int st = fesd__use_level(it, it->set.n_fe);
   if (st) return st;
   for (int k = 0; k < it->nsys; k++) it->jump_in[k] = it->jump_out[k] = -1;

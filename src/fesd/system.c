@@ -19,6 +19,12 @@ void fesd__system_free(fesd__system *S) {
   free(S->rlb);
   free(S->rx);
   free(S->X);
+  free(S->pc_z);
+  free(S->pc_xu);
+  free(S->pt_X);
+  free(S->pt_t);
+  free(S->pt_lvl);
+  free(S->pt_u);
   free(S->Jth);
   free(S->JK);
   free(S->KG);
@@ -252,6 +258,7 @@ static void emit_values(const fesd__system *S, const double *z, double *val) {
 
 void fesd__system_set_N(fesd__system *S, int N) {
   S->N = N;
+  S->pc_valid = 0;
   S->n = N * S->eb;
   const int row = N * S->erows;
   S->rH0 = row;
@@ -346,6 +353,13 @@ int fesd__system_init(fesd__system *S, fesd__model *m, const fesd_tableau *tab, 
   S->Juth = malloc((size_t)N * s * nx * nu1 * sizeof(double));
   S->lam00_dp = malloc((sens ? (size_t)nth * (nx + nu) : 1) * sizeof(double)); /* O(n^2) */
   S->tmp = malloc((size_t)(4 * nx + nth) * sizeof(double));
+  S->pc_z = malloc((size_t)N * S->eb * sizeof(double));
+  S->pc_xu = malloc((size_t)(nx + nu) * sizeof(double));
+  S->pt_X = malloc((size_t)N * s * nx * sizeof(double) + 1);
+  S->pt_t = malloc((size_t)N * s * sizeof(double));
+  S->pt_lvl = calloc((size_t)N * s, 1);
+  S->pt_u = malloc((size_t)nu * sizeof(double) + 1);
+  if (!S->pc_z || !S->pc_xu || !S->pt_X || !S->pt_t || !S->pt_lvl || !S->pt_u) goto nomem;
   if (!S->pe || !S->X || !S->Jth || !S->JK || !S->KG || !S->Juth || !S->lam00_dp || !S->tmp)
     goto nomem;
   for (int p = 0; p < np; p++)
@@ -365,105 +379,6 @@ int fesd__system_init(fesd__system *S, fesd__model *m, const fesd_tableau *tab, 
 nomem:
   fesd__system_free(S);
   return FESD_ERR_NOMEM;
-}
-
-/* Look-ahead term of element n's first stage (X = x_n, pe evaluated there with grad g):
- * LK = kappa h grad g . v_1; with want_jac also its derivatives: d/dh (KG), d/dx_n = grad g +
- * kappa h H v_1 (dgl; H v_1 by a forward difference of the switch Jacobian along v_1, exact
- * for affine switching functions) and, with sensitivities, d/du (dgul). */
-static int look_ahead(fesd__system *S, const double *z, int n, double tn, const fesd__point_eval *pe,
-                      int want_jac) {
-  fesd__model *m = S->model;
-  const int nx = S->nx, nth = S->nth, nu = S->nu, ndg = m->ndg;
-  const double h = z[S->ho[n]], kh = S->kappa * h, *v1 = z + fesd__v(S, n, 0);
-  const double *X = S->X + (size_t)n * S->s * nx;
-  for (int i = 0; i < nth; i++) {
-    const double d = fesd__dg_dot(m, pe, i, v1);
-    S->LK[(size_t)n * nth + i] = kh * d;
-    if (want_jac) S->KG[(size_t)n * S->s * nth + i] = S->kappa * d;
-  }
-  if (!want_jac) return FESD_OK;
-  double *dgl = S->dgl + (size_t)n * ndg, *dgul = S->dgul + (size_t)n * nth * nu;
-  const int want_u = S->want_u && nu > 0;
-  memcpy(dgl, pe->dgdx, (size_t)ndg * sizeof(double));
-  if (want_u) memcpy(dgul, pe->dgdu, (size_t)nth * nu * sizeof(double));
-  double vn = 0, xn = 0;
-  for (int r = 0; r < nx; r++) {
-    vn = fmax(vn, fabs(v1[r]));
-    xn = fmax(xn, fabs(X[r]));
-  }
-  if (vn == 0.0 || kh == 0.0) return FESD_OK;
-  const double delta = 1.5e-8 * fmax(xn, 1e-300) / vn; /* relative step along v_1 */
-  for (int r = 0; r < nx; r++) S->xs[r] = X[r] + delta * v1[r];
-  fesd__point_eval q = S->pl;
-  q.g = NULL;
-  if (!want_u) q.dgdu = NULL;
-  int st = fesd__model_eval(m, tn, S->xs, S->u, &q);
-  if (st) return st;
-  const double sc = kh / delta;
-  for (int e = 0; e < ndg; e++) dgl[e] += sc * (q.dgdx[e] - pe->dgdx[e]);
-  if (want_u)
-    for (int e = 0; e < nth * nu; e++) dgul[e] += sc * (q.dgdu[e] - pe->dgdu[e]);
-  return FESD_OK;
-}
-
-/* Evaluate the model at every stage point (and boundary point) of z. */
-int fesd__system_points(fesd__system *S, const double *z, int want_jac) {
-  const int N = S->N, s = S->s, nx = S->nx, nth = S->nth, nu = S->nu;
-  fesd__model *m = S->model;
-  double *K = S->tmp; /* K_j = sum_l a_jl v_l */
-  double tn = S->t0;
-  for (int n = 0; n < N; n++) {
-    const double *xn = elem_start(S, z, n);
-    const double h = z[S->ho[n]];
-    for (int j = 0; j < s; j++) {
-      const int p = n * s + j;
-      double *X = S->X + (size_t)p * nx;
-      for (int r = 0; r < nx; r++) {
-        double acc = 0;
-        for (int l = 0; l < s; l++) acc += S->tab.A[j][l] * z[fesd__v(S, n, l) + r];
-        K[r] = acc;
-        X[r] = xn[r] + h * acc;
-      }
-      fesd__point_eval pe = S->pe[p];
-      const int lk = S->look && j == 0; /* needs grad g for its value */
-      if (!want_jac) pe.dFdx = NULL;
-      if (!want_jac && !lk) pe.dgdx = NULL;
-      if (!(want_jac && S->want_u)) pe.dFdu = pe.dgdu = NULL;
-      int st = fesd__model_eval(m, tn + S->tab.c[j] * h, X, S->u, &pe);
-      if (st) return st;
-      if (lk && (st = look_ahead(S, z, n, tn, &pe, want_jac))) return st;
-      if (want_jac) {
-        const double *th = z + fesd__th(S, n, j);
-        double *J = S->Jth + (size_t)p * m->pf_nnz;
-        fesd__Jth(m, &pe, th, J);
-        fesd__pf_mv(m, J, K, S->JK + (size_t)p * nx);
-        if (!lk)
-          for (int i = 0; i < nth; i++) S->KG[(size_t)p * nth + i] = fesd__dg_dot(m, &pe, i, K);
-        if (S->want_u && nu > 0) {
-          double *Ju = S->Juth + (size_t)p * nx * nu;
-          memset(Ju, 0, (size_t)nx * nu * sizeof(double));
-          for (int i = 0; i < nth; i++) {
-            if (th[i] == 0.0) continue;
-            const int k = m->sys_of[i];
-            const double *d = pe.dFdu + m->Fuoff[i];
-            for (int c = 0; c < nu; c++)
-              for (int r = 0; r < m->nr[k]; r++) Ju[c * nx + m->rows[k][r]] += th[i] * d[c * m->nr[k] + r];
-          }
-        }
-      }
-    }
-    if (S->lbo[n] >= 0) {
-      fesd__point_eval pb = S->pe[N * s + n];
-      pb.F = pb.dFdx = pb.dFdu = NULL;
-      if (!want_jac) pb.dgdx = NULL;
-      if (!(want_jac && S->want_u)) pb.dgdu = NULL;
-      int st = fesd__model_eval(m, tn + h, z + S->xo[n], S->u, &pb);
-      if (st) return st;
-    }
-    tn += h;
-  }
-  return FESD_OK;
 }
 
 int fesd__system_eval(const double *z, double *raw, double *jac, void *ctx) {

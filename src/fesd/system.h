@@ -91,7 +91,28 @@ typedef struct {
    * indicators), and their maxima over the accepted steps (weights.c) */
   double *magX, *magV, *magG, *refX, *refV, *refG;
   int status;   /* last model status */
+  /* Inputs of the last fesd__system_points (z, x0, u, t0, want_u; pc_jac: with Jacobians):
+   * the weights and the solver's first residual evaluate the same z, and a Newton step's
+   * Jacobian the z of its residual, so repeated points are not evaluated again. Whoever writes
+   * X or pe outside fesd__system_points clears pc_valid (fesd__system_points_stale). */
+  double *pc_z, *pc_xu, pc_t0;
+  int pc_valid, pc_jac, pc_want_u;
+  /* What pe[p] of stage point p holds: evaluated at (pt_t[p], pt_X[p]) with level pt_lvl[p]
+   * (0 nothing reusable, 1 values, 2 with x-Jacobians, 3 also u-Jacobians). The consistent
+   * guess evaluates the stage points in full for its LP rows, and the weights then reuse
+   * them. Cleared at every step start (fesd__system_points_reset) and when u changes. */
+  double *pt_X, *pt_t, *pt_u; /* pt_u: the controls of every record */
+  signed char *pt_lvl;
 } fesd__system;
+
+/* Stage point p evaluated at (t, X) into pe[p] (with Jacobians if want_jac), unless it holds
+ * that already; NULL if a callback failed (its status in S->status). */
+const fesd__point_eval *fesd__system_stage_eval(fesd__system *S, int p, double t, const double *X, int want_jac);
+/* Nothing evaluated before is reused (the callbacks' user data may have changed). */
+void fesd__system_points_reset(fesd__system *S);
+
+/* The outputs of fesd__system_points are no longer those of its last inputs. */
+static inline void fesd__system_points_stale(fesd__system *S) { S->pc_valid = 0; }
 
 /* Storage for up to N_cap elements (the layout starts with N = N_cap); sens: allocate the
  * parameter-derivative storage of sensitivities (O(nth (nx + nu))). Weights start at 1. */
