@@ -13,6 +13,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "fesd.h"
 #include "problems/problems.h"
@@ -138,6 +139,7 @@ int main(int argc, char **argv) {
     if (k < NCTRL) printf(" %10.5f %10.5f", u[2 * k], u[2 * k + 1]);
     printf("\n");
   }
+  mkdir(outdir, 0755); /* an existing directory is fine; open_csv reports real failures */
   FILE *traj = open_csv(outdir, "ocp_step_eq_traj.csv", "t,k,q1,q2,v1,v2,u1,u2");
   FILE *el = open_csv(outdir, "ocp_step_eq_elements.csv", "k,n,t,h");
   FILE *evf = open_csv(outdir, "ocp_step_eq_events.csv", "t,sys,kind,n_before,n_after");
