@@ -4,6 +4,9 @@
  *   bench_step_cost list                 the cases, one per line
  *   bench_step_cost steps CASE K         run CASE; collect (callgrind client requests) only
  *                                        during K consecutive ordinary steps
+ *   bench_step_cost phases PROB S NSIM   integrate PROB (fixed steps T / NSIM); under callgrind
+ *                                        --collect-atstart=no one dump per phase: create (with
+ *                                        set_state), each step (named with its kind), free
  *   bench_step_cost states               final state of every case (%a: a change of the
  *                                        results shows bit for bit)
  *   bench_step_cost cpu [OUTDIR]         CPU time per integration of every case (bench_time):
@@ -159,6 +162,46 @@ static int cpu_mode(void) {
   return 0;
 }
 
+/* Fixed costs: fesd_create and each step (e.g. the first switch step) as callgrind dumps. */
+static int phases_run(const step_case *c, const setup *S, int run) {
+  const int nsim = c->nsim;
+  char name[96];
+  snprintf(name, sizeof name, "run %d create", run);
+  CALLGRIND_TOGGLE_COLLECT;
+  fesd_integrator *it = create(c, S);
+  CALLGRIND_DUMP_STATS_AT(name);
+  int st = it ? 0 : 1;
+  for (int k = 0; k < nsim && !st; k++) {
+    fesd_step_info in;
+    st = fesd_step(it, S->u, S->h, &in);
+    CALLGRIND_TOGGLE_COLLECT; /* the label is no part of the step */
+    snprintf(name, sizeof name, "run %d step %d %s newton %d factor %d solves %d", run, k,
+             st ? "failed" : in.switch_step ? "switch" : ordinary(it, &in) ? "ordinary" : "other", in.newton_iter,
+             in.factorizations, in.solves);
+    CALLGRIND_TOGGLE_COLLECT;
+    CALLGRIND_DUMP_STATS_AT(name);
+  }
+  CALLGRIND_TOGGLE_COLLECT;
+  snprintf(name, sizeof name, "run %d free", run);
+  CALLGRIND_TOGGLE_COLLECT;
+  fesd_free(&it);
+  CALLGRIND_DUMP_STATS_AT(name);
+  CALLGRIND_TOGGLE_COLLECT;
+  return st;
+}
+
+/* Two identical integrations: the first pays the process's one-time costs (lazy symbol
+ * binding, heap growth, memoized tableaus), the second is what repeated use costs. */
+static int phases_mode(const char *prob, int s, int nsim) {
+  step_case c = {"phases", prob, s, nsim};
+  setup S;
+  if (make(&c, &S)) return 1;
+  int st = phases_run(&c, &S, 1);
+  if (!st) st = phases_run(&c, &S, 2);
+  unmake(&S);
+  return st != 0;
+}
+
 static int states_mode(void) {
   for (int i = 0; i < N_CASES; i++) {
     setup S;
@@ -193,10 +236,11 @@ int main(int argc, char **argv) {
     fprintf(stderr, "unknown case %s\n", argv[2]);
     return 1;
   }
+  if (argc == 5 && !strcmp(argv[1], "phases")) return phases_mode(argv[2], atoi(argv[3]), atoi(argv[4]));
   if (argc >= 2 && !strcmp(argv[1], "cpu")) {
     if (bench_init(argc - 1, argv + 1, "bench_step_cost cpu [--quick] [OUTDIR]")) return 1;
     return cpu_mode();
   }
-  fprintf(stderr, "usage: bench_step_cost list | steps CASE K | cpu [--quick] [OUTDIR]\n");
+  fprintf(stderr, "usage: bench_step_cost list | steps CASE K | phases PROB S NSIM | states | cpu [--quick] [OUTDIR]\n");
   return 1;
 }
