@@ -358,7 +358,7 @@ int fesd__system_init(fesd__system *S, fesd__model *m, const fesd_tableau *tab, 
   S->pt_X = malloc((size_t)N * s * nx * sizeof(double) + 1);
   S->pt_t = malloc((size_t)N * s * sizeof(double));
   S->pt_lvl = calloc((size_t)N * s, 1);
-  S->pt_u = malloc((size_t)nu * sizeof(double) + 1);
+  S->pt_u = calloc((size_t)nu + 1, sizeof(double)); /* compared before the first record */
   if (!S->pc_z || !S->pc_xu || !S->pt_X || !S->pt_t || !S->pt_lvl || !S->pt_u) goto nomem;
   if (!S->pe || !S->X || !S->Jth || !S->JK || !S->KG || !S->Juth || !S->lam00_dp || !S->tmp)
     goto nomem;
