@@ -211,6 +211,19 @@ static const unsigned char *set_before_switch(fesd_integrator *it, int e) {
   return best < 0 ? it->act0 : after(it, best);
 }
 
+/* Fields, indicators and their state gradients at time t of the current solution z (its
+ * collocation polynomial), in the scratch buffers (valid until the next scratch use). */
+static int eval_on_path(fesd_integrator *it, const double *z, double t, fesd__point_eval *pe) {
+  fesd__system *S = &it->sys;
+  double *x = it->gbuf + it->nth;
+  fesd__state_at(it, z, S->N, t, x);
+  *pe = (fesd__point_eval){0};
+  pe->F = it->pscr.F;
+  pe->g = it->pscr.g;
+  pe->dgdx = it->pscr.dgdx;
+  return fesd__model_eval(&it->model, S->t0 + t, x, S->u, pe);
+}
+
 /* Entering mode j next to the set P of subsystem k at time t of the solution z: a crossing
  * (j alone) when j's field points into j's region, else a sliding mode (P and j). */
 static int enter_set(fesd_integrator *it, const double *z, double t, int k, const unsigned char *P, int j,
@@ -222,13 +235,8 @@ static int enter_set(fesd_integrator *it, const double *z, double t, int k, cons
   int cross = 0;
   if (n_act == 1) {
     fesd__system *S = &it->sys;
-    double *x = it->gbuf + it->nth;
-    fesd__state_at(it, z, S->N, t, x);
-    fesd__point_eval pe = {0};
-    pe.F = it->pscr.F;
-    pe.g = it->pscr.g;
-    pe.dgdx = it->pscr.dgdx;
-    int st = fesd__model_eval(&it->model, S->t0 + t, x, S->u, &pe);
+    fesd__point_eval pe;
+    int st = eval_on_path(it, z, t, &pe);
     if (st) return st;
     /* thetas of the other subsystems: the stage nearest before t */
     double tn = 0;
@@ -275,16 +283,10 @@ static void start_jump(fesd_integrator *it, int k, const unsigned char *newset) 
  * mode, l another active one), relative to the sizes (1e-8). Otherwise k's sliding
  * multiplier is continuous there and its exit is a pinned one. */
 static int coupled(fesd_integrator *it, const double *z, double t, int k, int i, int j, int *out) {
-  fesd__system *S = &it->sys;
   fesd__model *m = &it->model;
   *out = 0;
-  double *x = it->gbuf + it->nth;
-  fesd__state_at(it, z, S->N, t, x);
-  fesd__point_eval pe = {0};
-  pe.F = it->pscr.F;
-  pe.g = it->pscr.g;
-  pe.dgdx = it->pscr.dgdx;
-  int st = fesd__model_eval(m, S->t0 + t, x, S->u, &pe);
+  fesd__point_eval pe;
+  int st = eval_on_path(it, z, t, &pe);
   if (st) return st;
   int l = -1; /* another mode of k active just before t */
   const unsigned char *P = it->act0;

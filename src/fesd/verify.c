@@ -147,8 +147,8 @@ static void scan_signs(fesd_integrator *it, const double *z, const unsigned char
            * implicit c_j = 0 stage are still part of the field the step integrates (b_j > 0):
            * a negative one there (a sliding element whose first stage pulls the state onto
            * the surface from off it) is checked like any other. */
-          if (!strict && (S->tab.is_explicit ? !a : (S->tab.c[j] == 0.0 && !a))) continue;
-          if (!strict && S->tab.is_explicit && S->tab.c[j] == 0.0) continue;
+          const int c0 = S->tab.c[j] == 0.0;
+          if (!strict && (S->tab.is_explicit ? c0 || !a : c0 && !a)) continue;
           t = tn + S->tab.c[j] * h;
           val = a ? z[fesd__th(S, n, j) + i] : z[fesd__la(S, n, j) + i] * S->wth[i];
         } else {
@@ -258,8 +258,8 @@ static int two_modes(const fesd_integrator *it, const unsigned char *a, int k, i
  * k's mode: the sliding mode stands if neither of k's modes, alone and with the other sliding
  * subsystems' multipliers solved again, is a consistent continuation (its field keeps it in
  * its region and the others still slide). Returns 1 if some alternative is consistent. */
-static int alternative_exists(fesd_integrator *it, const fesd__point_eval *pe, const double *th,
-                              const unsigned char *a, int k, int i, int j) {
+static int alternative_exists(fesd_integrator *it, const fesd__point_eval *pe, const unsigned char *a, int k, int i,
+                              int j) {
   const fesd__model *m = &it->model;
   const int nth = m->nth, nx = m->nx;
   int coupled = 0;
@@ -288,7 +288,6 @@ static int alternative_exists(fesd_integrator *it, const fesd__point_eval *pe, c
       if (il >= 0) ok = filippov(it, pe, th2, f2, il, jl, FIL_STAGE_TOL) == -2;
     }
     found = ok;
-    (void)th;
   }
   memcpy(it->ftot, keep, (size_t)nx * sizeof(double));
   return found;
@@ -334,7 +333,7 @@ static int scan_filippov(fesd_integrator *it, const double *z, const unsigned ch
            * the remaining field is tangent there) */
           if (S->tab.c[q] == 1.0 && n + 1 < S->N && set_changes(it, act, n + 1, k)) continue;
           int c = filippov(it, &pe, th, it->ftot, i, j, FIL_STAGE_TOL);
-          if (c == -2 || !alternative_exists(it, &pe, th, a, k, i, j)) continue;
+          if (c == -2 || !alternative_exists(it, &pe, a, k, i, j)) continue;
           fesd__violation v = {1, tn + S->tab.c[q] * h, c < 0 ? i : c, k, 0, n, n * s + q, 0, 1, 0, 0};
           v.filippov = c < 0 ? -1 : 1;
           note(&ps[k], &v);
@@ -394,7 +393,7 @@ static int scan_interior(fesd_integrator *it, const double *z, const unsigned ch
         int j, i = two_modes(it, a, k, &j);
         if (i < 0 || !sliding) continue;
         int c = filippov(it, &q, th, it->ftot, i, j, FIL_MID_TOL);
-        if (c == -2 || !alternative_exists(it, &q, th, a, k, i, j)) continue;
+        if (c == -2 || !alternative_exists(it, &q, a, k, i, j)) continue;
         fesd__violation v = {1, t, c < 0 ? i : c, k, 0, n, n * s + s, 0, c < 0 ? -1 : 1, 0, 0};
         note(&ps[k], &v);
       }
