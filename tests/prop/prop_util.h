@@ -46,6 +46,18 @@ typedef struct {
   int splits, substeps, newton_iter;
 } pr_run;
 
+/* Appends the events of the integrator's last step to r (up to PR_MAX_EV). */
+static inline void pr_record_events(const fesd_integrator *it, pr_run *r) {
+  const fesd_event *ev;
+  int ne;
+  fesd_last_events(it, &ev, &ne);
+  for (int e = 0; e < ne && r->n_ev < PR_MAX_EV; e++, r->n_ev++) {
+    r->ev_t[r->n_ev] = ev[e].t;
+    r->ev_sys[r->n_ev] = ev[e].sys;
+    r->ev_kind[r->n_ev] = (int)ev[e].kind;
+  }
+}
+
 /* N_sim steps of length T/N_sim from (0, x0) with constant u, on an existing integrator
  * (fesd_set_state restarts it: no warm start survives). */
 static inline int pr_run_on(fesd_integrator *it, const fesd_model *m, int sens, const double *x0, const double *u,
@@ -62,14 +74,7 @@ static inline int pr_run_on(fesd_integrator *it, const fesd_model *m, int sens, 
     }
     r->flags |= info.flags;
     r->splits += info.splits, r->substeps += info.substeps, r->newton_iter += info.newton_iter;
-    const fesd_event *ev;
-    int ne;
-    fesd_last_events(it, &ev, &ne);
-    for (int e = 0; e < ne && r->n_ev < PR_MAX_EV; e++, r->n_ev++) {
-      r->ev_t[r->n_ev] = ev[e].t;
-      r->ev_sys[r->n_ev] = ev[e].sys;
-      r->ev_kind[r->n_ev] = (int)ev[e].kind;
-    }
+    pr_record_events(it, r);
   }
   fesd_get_state(it, NULL, r->x);
   if (sens) fesd_get_sensitivities(it, r->Sx, m->nu > 0 ? r->Su : NULL);

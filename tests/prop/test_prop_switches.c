@@ -113,14 +113,7 @@ static double run_hmax(const fesd_model *m, const fesd_settings *set, const doub
     fesd_step_data d;
     fesd_last_step_data(it, &d);
     for (int e = 0; e < d.n_elements; e++) hmax = fmax(hmax, d.h[e]);
-    const fesd_event *ev;
-    int ne;
-    fesd_last_events(it, &ev, &ne);
-    for (int e = 0; e < ne && r->n_ev < PR_MAX_EV; e++, r->n_ev++) {
-      r->ev_t[r->n_ev] = ev[e].t;
-      r->ev_sys[r->n_ev] = ev[e].sys;
-      r->ev_kind[r->n_ev] = (int)ev[e].kind;
-    }
+    pr_record_events(it, r);
   }
   fesd_get_state(it, NULL, r->x);
   fesd_free(&it);
