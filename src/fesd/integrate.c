@@ -363,7 +363,8 @@ int fesd_integrate_grid(fesd_integrator *it, const double *u, int n, const doubl
     if (st != FESD_OK && st != FESD_ROOT) break;
     if (dense) {
       while (done < n && t_out[done] <= it->t) {
-        if (fesd_dense_output(it, t_out[done], x_out + (size_t)done * it->nxu))
+        /* at the step end the state itself (the polynomial gives it up to round-off) */
+        if (t_out[done] == it->t || fesd_dense_output(it, t_out[done], x_out + (size_t)done * it->nxu))
           memcpy(x_out + (size_t)done * it->nxu, it->x, (size_t)it->nxu * sizeof(double));
         done++;
       }

@@ -120,6 +120,7 @@ struct fesd_integrator {
   fesd__switch *plan;
   unsigned char *plan_after;
   int n_plan, cap_plan;
+  int plan_peak; /* most subsystems switching in a plan of this attempt (fesd__plan_subsystems) */
   double merge_tol; /* switches of different subsystems closer than this share a boundary */
   int split_layout; /* the layout splits elements longer than T / N_FE (after a failed solve) */
   double *bt;       /* boundary times of the layout (cap_plan + 2) */

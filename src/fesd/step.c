@@ -412,6 +412,8 @@ static int plan_path(fesd_integrator *it, double *T, fesd_step_info *info) {
     }
     if (r < 0) return r;
     if (r == 0) return FESD_ERR_STEP_FAILED;
+    const int nsw = fesd__plan_subsystems(it);
+    if (nsw > it->plan_peak) it->plan_peak = nsw;
     for (;;) { /* solve the new plan; retreat to fewer new switches while it fails */
       st = fesd__plan_layout(it, S->T, z);
       if (st == FESD_ERR_TOO_MANY_SWITCHES) {
@@ -487,6 +489,11 @@ static int try_step(fesd_integrator *it, const double *u, double *T, fesd_step_i
   if (st != FESD_OK) {
     info->failed_path = it->set.method == FESD_METHOD_FESD ? "plan" : "standard";
     info->failed_residual = info->residual;
+    /* The FB fallback gives each switch one of the N_FE - 1 inner boundaries (the switches of
+     * two subsystems at a corner can share one): a step whose plan had more subsystems
+     * switching than N_FE is left to halving (stick-slip chain n = 256: a failed FB attempt
+     * cost 450 Newton iterations). */
+    if (it->set.method == FESD_METHOD_FESD && it->plan_peak > it->set.n_fe) return st;
     *T = T_full;
     S->T = T_full;
     for (int k = 0; k < it->nsys; k++) it->jump_in[k] = it->jump_out[k] = -1;

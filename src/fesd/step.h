@@ -81,12 +81,15 @@ int fesd__plan_update(fesd_integrator *it, const double *z, const fesd__violatio
  * half of them (the later ones were predicted from a trajectory that the earlier ones change).
  * Returns 1 if it changed the plan, 0 if there is nothing to take back. */
 int fesd__plan_retreat(fesd_integrator *it);
+/* Number of distinct subsystems that switch in the plan. */
+int fesd__plan_subsystems(const fesd_integrator *it);
 /* Midway between the earliest fresh switch and the next switch (or T). */
 double fesd__plan_cut_after_fresh(fesd_integrator *it);
 /* Keep only the switches before t (a shorter sub-step). */
 void fesd__plan_truncate(fesd_integrator *it, double t);
 /* Time before which at most n_max switches of the plan lie (the end of a sub-step that holds
- * them): midway between switch n_max and the next (T when there are no more). */
+ * them): midway in the widest gap between switches n_max / 2 .. n_max and their next (T when
+ * there are no more). */
 double fesd__plan_cut(fesd_integrator *it, int n_max);
 
 /* ---- error.c ---- */

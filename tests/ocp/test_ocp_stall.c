@@ -87,7 +87,7 @@ int main(void) {
          info.feasibility, 1e3 * info.time_total);
   CHECK(st == FESD_ERR_LINE_SEARCH && info.status == st, "status %s", fesd_status_name(st));
   CHECK(info.stalled == 1 && info.hessian_fallback == 1, "stalled %d fallback %d", info.stalled, info.hessian_fallback);
-  CHECK(info.iterations >= 2 * W && info.iterations <= 2 * W + 15, "iterations %d (before the rule: 200)", info.iterations);
+  CHECK(info.iterations >= 2 * W && info.iterations <= 2 * W + 20, "iterations %d (before the rule: 200)", info.iterations);
   CHECK(info.integrations < 2000, "integrations %d (before the rule: 16190)", info.integrations);
   CHECK(nlog == info.iterations + (st == FESD_ERR_LINE_SEARCH ? 0 : 1), "log lines %d", nlog);
   /* the returned iterate is a visited one, with the logged residuals, better than the start */
@@ -104,7 +104,7 @@ int main(void) {
   printf("  returned iterate: dynamics defect %.3e (reported feasibility %.3e)\n", dd, info.feasibility);
   CHECK(dd <= info.feasibility * (1 + 1e-6) + 1e-12 && dd >= 0.5 * info.feasibility, "defect %.3e vs feasibility %.3e",
         dd, info.feasibility);
-  CHECK(info.feasibility > 1e-6 && info.feasibility < 1e-3, "feasibility %.3e", info.feasibility);
+  CHECK(info.feasibility > 0 && info.feasibility < 1e-3, "feasibility %.3e", info.feasibility);
 
   /* plain Gauss-Newton: no fallback, stops after the first window */
   st = solve(&P, FESD_RK_LOBATTO_IIIC, 2, FESD_OCP_HESSIAN_GAUSS_NEWTON, &info, x, u, &is);
