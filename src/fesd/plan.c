@@ -18,6 +18,8 @@
 
 /* Active sets tried after one switch before the plan gives up on it. */
 #define MAX_TRIES 4
+/* A sub-step ends in a gap between switches at least this fraction of the widest one. */
+#define CUT_GAP 0.1
 /* A switch predicted this close to the step start (fraction of T) happens at the start. */
 #define AT_START 1e-9
 
@@ -186,13 +188,15 @@ void fesd__plan_times(fesd_integrator *it, const double *z) {
 double fesd__plan_cut(fesd_integrator *it, int n_max) {
   sort_plan(it);
   if (it->n_plan <= n_max) return it->sys.T;
-  /* the widest gap among the last half of the switches that fit: a cut inside a cluster of
-   * nearly simultaneous switches leaves out a member whose predicted time may be off by more
-   * than the gap (stick-slip chain, n = 128: four masses within 2.5 us, the sub-step ended
-   * 0.5 us after the third and the plan solve failed) */
+  /* the last gap at least CUT_GAP times the widest one: a cut inside a cluster of nearly
+   * simultaneous switches leaves out a member whose predicted time may be off by more than
+   * the gap, and the plan solve fails (stick-slip chain, n = 128: four masses within 2.5 us,
+   * the sub-step ended 0.5 us after the third; n = 512: a cluster of 17 within 20 us was cut
+   * into, and failed, in one sub-step after another) */
+  double widest = 0;
+  for (int r = 1; r <= n_max; r++) widest = fmax(widest, it->plan[r].t - it->plan[r - 1].t);
   int q = n_max;
-  for (int r = n_max - 1; r >= 1 && 2 * r >= n_max; r--)
-    if (it->plan[r].t - it->plan[r - 1].t > it->plan[q].t - it->plan[q - 1].t) q = r;
+  while (q > 1 && it->plan[q].t - it->plan[q - 1].t < CUT_GAP * widest) q--;
   const double ta = q > 0 ? it->plan[q - 1].t : 0.0, tb = it->plan[q].t;
   return 0.5 * (ta + tb);
 }

@@ -88,8 +88,8 @@ double fesd__plan_cut_after_fresh(fesd_integrator *it);
 /* Keep only the switches before t (a shorter sub-step). */
 void fesd__plan_truncate(fesd_integrator *it, double t);
 /* Time before which at most n_max switches of the plan lie (the end of a sub-step that holds
- * them): midway in the widest gap between switches n_max / 2 .. n_max and their next (T when
- * there are no more). */
+ * them): midway in the last gap between switch q and the next (q <= n_max) that is not much
+ * narrower than the widest one (T when there are no more). */
 double fesd__plan_cut(fesd_integrator *it, int n_max);
 
 /* ---- error.c ---- */
