@@ -9,6 +9,11 @@
  *    slope >= p - 0.7 over the errors above 1e-10); the event sequence (subsystem and kind)
  *    is the reference's; Newton iterations of the steps that hold events <= 4 per event, and
  *    <= 30 in the worst step.
+ * Larger chains, n = 128 and 256 over T = 4 (h = 0.2: steps with 20-85 switches, clusters of
+ * masses 29 apart that switch within microseconds of each other): <= 4 Newton iterations per
+ * event over the run and in the worst step (before the entry times came from the collocation
+ * polynomial: a step with 7 events took 607), and the events are those of the same method at
+ * h / 4; halvings are printed.
  * Plus two decoupled relays that both cross inside one step (x_k' = 2 - sign(x_k), exact):
  * exact state and <= 20 Newton iterations for that step. Worst steps are printed. */
 #include "hard_util.h"
@@ -16,7 +21,8 @@
 
 typedef struct {
   int st, n_ev, steps_done, iters, iters_sw, worst_iter, worst_ev; /* iters_sw: of the steps holding events */
-  double x[2 * 64];
+  int splits; /* halvings */
+  double x[2 * 256];
   int ev_sys[4096], ev_kind[4096];
 } chain_run;
 
@@ -31,12 +37,13 @@ static int run_chain(int n, double T, fesd_rk_family fam, int s, double h, chain
   int st = fesd_create(&it, &fc.model, &set);
   if (!st) st = fesd_set_state(it, 0.0, fc.x0, NULL);
   const int K = (int)lround(T / h);
-  r->n_ev = r->steps_done = r->worst_iter = r->iters_sw = 0;
+  r->n_ev = r->steps_done = r->worst_iter = r->iters_sw = r->splits = 0;
   for (int k = 0; k < K && !st; k++) {
     fesd_step_info info;
     st = fesd_step(it, NULL, h, &info);
     if (st) break;
     r->steps_done++;
+    r->splits += info.splits;
     const fesd_event *ev;
     int ne;
     fesd_last_events(it, &ev, &ne);
@@ -112,6 +119,20 @@ int main(void) {
       printf("chain n=%d s=%d: order %.2f over %d runs (method order %d)\n", n, s, p, nfit, 2 * s - 1);
       HD_CHECK(nfit < 2 || p >= 2 * s - 1 - 0.7, "n=%d s=%d: order %.2f", n, s, p);
     }
+  }
+  for (int c = 0; c < 2; c++) {
+    const int n = c ? 256 : 128;
+    HD_CHECK(run_chain(n, 4.0, FESD_RK_RADAU_IIA, 2, 0.05, &R) == FESD_OK, "n=%d h=0.05: %s at step %d", n,
+             fesd_status_name(R.st), R.steps_done);
+    const int st = run_chain(n, 4.0, FESD_RK_RADAU_IIA, 2, 0.2, &A);
+    HD_CHECK(st == FESD_OK, "n=%d h=0.2: %s at step %d", n, fesd_status_name(st), A.steps_done);
+    if (st) continue;
+    const double per_ev = A.n_ev ? (double)A.iters_sw / A.n_ev : 0, worst_per_ev = (double)A.worst_iter / (A.worst_ev + 1);
+    HD_CHECK(same_events(&A, &R), "n=%d: %d events at h=0.2, %d at h=0.05", n, A.n_ev, R.n_ev);
+    HD_CHECK(per_ev <= 4.0 && worst_per_ev <= 4.0, "n=%d: %.2f Newton iterations per event, worst step %d with %d events",
+             n, per_ev, A.worst_iter, A.worst_ev);
+    printf("chain n=%d s=2 h=0.2 T=4: %d events (as at h=0.05), %d halvings, %.2f Newton iterations per event; worst "
+           "step %d with %d events\n", n, A.n_ev, A.splits, per_ev, A.worst_iter, A.worst_ev);
   }
   /* two decoupled relays crossing at t = 0.1 and t = 0.2 inside one step of 0.5 */
   {
