@@ -11,6 +11,8 @@
 #include "fesd_ncp.h"
 
 #define FESD_MAX_EVENTS_PER_STEP 256
+/* Plans remembered to detect a cycle of plan updates (step.c). */
+#define PLAN_SIGS 8
 /* Element counts with a solver workspace of their own (the ladder of layouts, integrator.c). */
 #define FESD__MAX_LEVELS 24
 
@@ -122,7 +124,9 @@ struct fesd_integrator {
   int n_plan, cap_plan;
   int plan_peak; /* most subsystems switching in a plan of this attempt (fesd__plan_subsystems) */
   double merge_tol; /* switches of different subsystems closer than this share a boundary */
-  int split_layout; /* the layout splits elements longer than T / N_FE (after a failed solve) */
+  int split_layout; /* k > 0: the layout splits elements longer than T / (N_FE 2^(k-1)) (after a
+                     * failed solve; finer after a plan that came back) */
+  unsigned long plan_sig[PLAN_SIGS]; /* signatures of the last plans of this attempt */
   double *bt;       /* boundary times of the layout (cap_plan + 2) */
   int *bseg;        /* elements per segment (cap_plan + 1) */
   double *hlo, *hhi; /* bounds of the element lengths of the layout (N_cap) */

@@ -28,6 +28,7 @@ void fesd__plan_reset(fesd_integrator *it) {
   it->plan_peak = 0;
   it->merge_tol = 1e-9;
   it->split_layout = 0;
+  memset(it->plan_sig, 0, sizeof it->plan_sig);
 }
 
 static unsigned char *after(fesd_integrator *it, int e) { return it->plan_after + (size_t)e * it->nth; }
@@ -108,7 +109,7 @@ int fesd__plan_layout(fesd_integrator *it, double T, double *z) {
    * element per switch step and a workspace level more. */
   int want = nb + 1 > it->set.n_fe ? nb + 1 : it->set.n_fe;
   if (it->split_layout) {
-    const double h_nom = T / it->set.n_fe;
+    const double h_nom = T / (it->set.n_fe * (double)(1 << (it->split_layout - 1)));
     int split = 0;
     for (int q = 0; q <= nb; q++) {
       const int c = (int)ceil((bt[q + 1] - bt[q]) / h_nom - 1e-6);
@@ -501,6 +502,20 @@ int fesd__plan_update(fesd_integrator *it, const double *z, const fesd__violatio
     if (w->fresh && w->t > t_new + 1e-9 * T) w->lo = fmin(w->lo, t_new), w->hi = T;
   }
   return changed;
+}
+
+unsigned long fesd__plan_signature(fesd_integrator *it) {
+  sort_plan(it);
+  /* FNV-1a over subsystem, mode, kind and time (in units of 1e-6 T: a cycle repeats its
+   * plans up to round-off, progress moves the times) of each switch */
+  unsigned long h = 1469598103934665603ul;
+  const double unit = 1e-6 * it->sys.T;
+  for (int e = 0; e < it->n_plan; e++) {
+    const unsigned long w[4] = {(unsigned long)it->plan[e].sys, (unsigned long)it->plan[e].mode,
+                                (unsigned long)it->plan[e].exit, (unsigned long)lround(it->plan[e].t / unit)};
+    for (int i = 0; i < 4; i++) h = (h ^ w[i]) * 1099511628211ul;
+  }
+  return h ^ (unsigned long)it->n_plan;
 }
 
 int fesd__plan_subsystems(const fesd_integrator *it) {

@@ -43,6 +43,8 @@ static int hard_failure(int st) {
  * too, halving the step is cheaper than cutting again; stick-slip chain, n = 128: the worst
  * step 137 -> 107 Newton iterations with one cut instead of three). */
 #define MAX_SHORTEN 1
+/* Finest layout after plan cycles: no element longer than T / (N_FE 2^(MAX_SPLIT_LEVEL - 1)). */
+#define MAX_SPLIT_LEVEL 3
 /* A sub-step ends before this many boundaries when the plan holds more (see plan_cut). */
 #define SUB_MARGIN 1
 
@@ -388,6 +390,24 @@ static void shorten(fesd_integrator *it, double *T) {
   it->sys.T = cut;
 }
 
+/* A plan that comes back twice within a few rounds (Gauss-Legendre pins a sliding exit by the
+ * extrapolated theta, order about s: the exit lands early, a re-entry follows, the exit is
+ * dropped, ...) is solved on finer elements, which place the switches more accurately; a
+ * cycle on the finest layout fails the attempt at once instead of running to MAX_ROUNDS
+ * (stick-slip chain n = 64, Gauss s = 2: 24 rounds of a 4-plan cycle in one step). */
+static int plan_cycle(fesd_integrator *it) {
+  const unsigned long sig = fesd__plan_signature(it);
+  int seen = 0;
+  for (int i = 0; i < PLAN_SIGS; i++) seen += it->plan_sig[i] == sig;
+  memmove(it->plan_sig + 1, it->plan_sig, (PLAN_SIGS - 1) * sizeof *it->plan_sig);
+  it->plan_sig[0] = sig;
+  if (seen < 2) return FESD_OK; /* a single return can be progress (a switch moved by less) */
+  if (it->split_layout >= MAX_SPLIT_LEVEL) return FESD_ERR_STEP_FAILED;
+  it->split_layout = it->split_layout ? it->split_layout + 1 : 2;
+  memset(it->plan_sig, 0, sizeof it->plan_sig);
+  return FESD_OK;
+}
+
 static int plan_path(fesd_integrator *it, double *T, fesd_step_info *info) {
   fesd__system *S = &it->sys;
   double *z = it->z, *zp = it->zp;
@@ -414,6 +434,7 @@ static int plan_path(fesd_integrator *it, double *T, fesd_step_info *info) {
     if (r == 0) return FESD_ERR_STEP_FAILED;
     const int nsw = fesd__plan_subsystems(it);
     if (nsw > it->plan_peak) it->plan_peak = nsw;
+    if ((st = plan_cycle(it))) return st;
     for (;;) { /* solve the new plan; retreat to fewer new switches while it fails */
       st = fesd__plan_layout(it, S->T, z);
       if (st == FESD_ERR_TOO_MANY_SWITCHES) {

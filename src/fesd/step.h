@@ -81,6 +81,8 @@ int fesd__plan_update(fesd_integrator *it, const double *z, const fesd__violatio
  * half of them (the later ones were predicted from a trajectory that the earlier ones change).
  * Returns 1 if it changed the plan, 0 if there is nothing to take back. */
 int fesd__plan_retreat(fesd_integrator *it);
+/* A hash of the plan's switches in time order (subsystem, mode, kind, time), to detect cycles. */
+unsigned long fesd__plan_signature(fesd_integrator *it);
 /* Number of distinct subsystems that switch in the plan. */
 int fesd__plan_subsystems(const fesd_integrator *it);
 /* Midway between the earliest fresh switch and the next switch (or T). */
