@@ -6,6 +6,7 @@
 
 #include "common/timer.h"
 #include "fesd/step.h"
+#include "ncp/ncp_defer.h"
 #include "ncp/ncp_nomem.h"
 
 int fesd_settings_default(fesd_settings *s) {
@@ -114,6 +115,8 @@ int fesd__use_level(fesd_integrator *it, int N) {
       ns.tol = it->set.newton_tol; /* tol and max_iter are set per solve (step.c) */
       ns.max_iter = it->set.max_iter;
       st = fesd_ncp_setup(&L->ncp, &p, &ns);
+      /* an ordinary step's solve starts converged: its selection needs no analysis */
+      if (st == FESD_OK) fesd__ncp_defer_analysis(L->ncp);
     }
     free(row);
     free(col);
