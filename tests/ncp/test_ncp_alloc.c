@@ -81,18 +81,24 @@ static void injection(prob_t *p, int backend) {
          fesd_ncp_backend_name(backend), k, nomem, other);
 }
 
-/* A failed re-analysis leaves the workspace refusing to solve until set_rows succeeds. */
-static void not_ready_after_failed_set_rows(prob_t *p) {
-  int n = p->lcp.n;
-  fesd_ncp_problem pr = {n, 2, n, p->nnz, p->row, p->col, extra_eval, p};
+/* A KLU workspace of p (its default selection, m = n + 2, would use CHOLMOD). */
+static fesd_ncp *klu_workspace(prob_t *p) {
+  fesd_ncp_problem pr = {p->lcp.n, 2, p->lcp.n, p->nnz, p->row, p->col, extra_eval, p};
   fesd_ncp_settings s;
   fesd_ncp_settings_default(&s);
   s.backend = FESD_NCP_BACKEND_KLU;
   fesd_ncp *ws = NULL;
+  CHECK_RC(fesd_ncp_setup(&ws, &pr, &s), FESD_OK);
+  return ws;
+}
+
+/* A failed re-analysis leaves the workspace refusing to solve until set_rows succeeds. */
+static void not_ready_after_failed_set_rows(prob_t *p) {
+  const int n = p->lcp.n;
+  fesd_ncp *ws = klu_workspace(p);
   unsigned char eq_off[2] = {0, 0};
   double z[20];
   fesd_ncp_info info;
-  CHECK_RC(fesd_ncp_setup(&ws, &pr, &s), FESD_OK); /* m = n + 2: CHOLMOD */
   g_count = 0;
   g_fail_at = 0; /* the first allocation of the KLU analysis fails */
   int rc = fesd_ncp_set_rows(ws, eq_off, NULL);
@@ -111,16 +117,11 @@ static void not_ready_after_failed_set_rows(prob_t *p) {
  * a failure of the analysis at the first Jacobian is returned by that solve, and the next
  * solve analyses again and succeeds. */
 static void deferred_analysis_retried(prob_t *p) {
-  int n = p->lcp.n;
-  fesd_ncp_problem pr = {n, 2, n, p->nnz, p->row, p->col, extra_eval, p};
-  fesd_ncp_settings s;
-  fesd_ncp_settings_default(&s);
-  s.backend = FESD_NCP_BACKEND_KLU;
-  fesd_ncp *ws = NULL;
+  const int n = p->lcp.n;
+  fesd_ncp *ws = klu_workspace(p);
   unsigned char eq_off[2] = {0, 0};
   double z[20], res;
   fesd_ncp_info info;
-  CHECK_RC(fesd_ncp_setup(&ws, &pr, &s), FESD_OK);
   fesd__ncp_defer_analysis(ws);
   for (int i = 0; i < n; i++) z[i] = 1.0;
   g_count = 0;
