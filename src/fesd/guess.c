@@ -4,83 +4,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "common/dense_lu.h"
 #include "fesd/step.h"
-
-/* Stage Newton of the guess, for systems of at most FESD__GN_MAX stage unknowns (s nx): with
- * theta fixed the stage equations v_j = F(X_j) theta_j are smooth; Newton with the matrix
- * I - h A (x) J_j, J_j = sum_i theta_j,i df_i/dx at x_n (one dense LU per element), converges
- * in 1-3 iterations from the warm start, also for stiff fields, where the fixed-point sweeps
- * need 8-16 passes or diverge. Returns 0 when the stage residual is at round-off level
- * (1e-14 of the stage derivatives), 1 otherwise (v is then left as it was: the sweeps take
- * over). The first residual is checked before any Jacobian: a converged guess costs s
- * evaluations. */
-static int stage_newton(fesd_integrator *it, double *z, int n, const double *xn, double h, double tn) {
-  fesd__system *S = &it->sys;
-  fesd__model *m = &it->model;
-  const int nx = S->nx, s = S->s, q = s * nx, nth = S->nth;
-  if (!it->gn || q > FESD__GN_MAX || S->tab.is_explicit) return 1;
-  double *M = it->gn, *G = M + (size_t)q * q, *V0 = G + q, *Jd = V0 + q, *X = S->X;
-  int *piv = it->gn_piv;
-  fesd__point_eval pe = {0};
-  pe.F = it->pscr.F;
-  for (int j = 0; j < s; j++) memcpy(V0 + j * nx, z + fesd__v(S, n, j), (size_t)nx * sizeof(double));
-  double gprev = INFINITY;
-  int factored = 0;
-  for (int iter = 0; iter < 6; iter++) {
-    double gmax = 0, vmax = 0;
-    for (int j = 0; j < s; j++) {
-      const double *v = z + fesd__v(S, n, j), *th = z + fesd__th(S, n, j);
-      for (int r = 0; r < nx; r++) {
-        double acc = 0;
-        for (int l = 0; l < s; l++) acc += S->tab.A[j][l] * z[fesd__v(S, n, l) + r];
-        X[r] = xn[r] + h * acc;
-      }
-      int st = fesd__model_fields_active(m, tn + S->tab.c[j] * h, X, S->u, pe.F, th);
-      if (st) goto restore; /* a failing callback: the sweeps report it */
-      double *g = G + j * nx;
-      memcpy(g, v, (size_t)nx * sizeof(double));
-      for (int i = 0; i < nth; i++)
-        if (th[i] != 0.0) fesd__F_axpy(m, &pe, i, -th[i], g);
-      for (int r = 0; r < nx; r++) {
-        gmax = fmax(gmax, fabs(g[r]));
-        vmax = fmax(vmax, fabs(v[r]));
-      }
-    }
-    if (!(gmax <= 1e300)) break; /* NaN or overflow: the sweeps decide */
-    if (gmax <= 1e-14 * vmax || gmax == 0.0) return 0;
-    if (gmax > 0.5 * gprev) break; /* not converging like Newton */
-    gprev = gmax;
-    if (!factored) { /* M = I - h (A (x) J_j), J_j per stage row (its own theta) */
-      fesd__point_eval pj = {0};
-      pj.dFdx = it->pscr.dFdx;
-      if (fesd__model_eval(m, tn, xn, S->u, &pj)) break;
-      memset(M, 0, (size_t)q * q * sizeof(double));
-      for (int j = 0; j < s; j++) {
-        fesd__Jth(m, &pj, z + fesd__th(S, n, j), it->gn_jth);
-        memset(Jd, 0, (size_t)nx * nx * sizeof(double));
-        for (int e = 0; e < m->pf_nnz; e++) Jd[m->pf_r[e] * nx + m->pf_c[e]] += it->gn_jth[e];
-        for (int l = 0; l < s; l++) {
-          const double a = h * S->tab.A[j][l];
-          double *Mc = M + (size_t)l * nx * q + j * nx; /* column l nx + c, rows j nx + r */
-          for (int c = 0; c < nx; c++, Mc += q)
-            for (int r = 0; r < nx; r++) Mc[r] = -a * Jd[r * nx + c];
-        }
-      }
-      for (int d = 0; d < q; d++) M[(size_t)d * q + d] += 1.0;
-      if (fesd__dense_lu(q, M, piv)) break;
-      factored = 1;
-    }
-    fesd__dense_lu_solve(q, M, piv, G); /* G <- M^{-1} G */
-    for (int j = 0; j < s; j++) {
-      double *v = z + fesd__v(S, n, j);
-      for (int r = 0; r < nx; r++) v[r] -= G[j * nx + r];
-    }
-  }
-restore:
-  for (int j = 0; j < s; j++) memcpy(z + fesd__v(S, n, j), V0 + j * nx, (size_t)nx * sizeof(double));
-  return 1;
-}
 
 /* Make a guess consistent with its theta and h: a few fixed-point sweeps
  * v_j = F(X_j) theta_j with X_j = x_n + h sum_l a_jl v_l (exact for explicit methods after
@@ -108,7 +32,7 @@ int fesd__consistent_guess(fesd_integrator *it, double *z) {
      * (Newton is then cheaper). A stiff mode makes them diverge (the guess overflows and
      * Newton fails), so when a sweep changes v clearly more than the previous one, the
      * stages are frozen at x_n for a last sweep: v_j = F(x_n) theta_j. */
-    const int newton_ok = stage_newton(it, z, n, xn, h, tn) == 0;
+    const int newton_ok = fesd__stage_newton(it, z, n, xn, h, tn) == 0;
     const int n_sweep = newton_ok ? 0 : S->tab.is_explicit ? s : it->set.max_sweeps;
     it->guess_fixed &= newton_ok;
     int frozen = 0;

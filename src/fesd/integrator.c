@@ -6,6 +6,7 @@
 
 #include "common/timer.h"
 #include "fesd/step.h"
+#include "ncp/ncp_defer.h"
 #include "ncp/ncp_nomem.h"
 
 int fesd_settings_default(fesd_settings *s) {
@@ -81,7 +82,7 @@ void fesd_free(fesd_integrator **itp) {
   void *other[] = {it->eq_active, it->pair_mode, it->pt_src, it->kb,   it->sw_at,    it->act,
                    it->act0,      it->cand,      it->swap_set, it->bmode, it->exit_mode, it->jump_in,
                    it->jump_out,  it->scan_buf,  it->plan,   it->plan_after, it->bseg, it->ev_pool, it->raw_border, it->col_border,
-                   it->gn, it->gn_jth, it->gn_piv, it->fil_th, it->fil_a, it->rk_act, it->rk_bmode};
+                   it->gn, it->gn_key, it->gn_piv, it->fil_th, it->fil_a, it->rk_act, it->rk_bmode};
   for (size_t i = 0; i < sizeof(other) / sizeof(other[0]); i++) free(other[i]);
   free(it);
   *itp = NULL;
@@ -114,6 +115,8 @@ int fesd__use_level(fesd_integrator *it, int N) {
       ns.tol = it->set.newton_tol; /* tol and max_iter are set per solve (step.c) */
       ns.max_iter = it->set.max_iter;
       st = fesd_ncp_setup(&L->ncp, &p, &ns);
+      /* an ordinary step's solve starts converged: its selection needs no analysis */
+      if (st == FESD_OK) fesd__ncp_defer_analysis(L->ncp);
     }
     free(row);
     free(col);
@@ -273,7 +276,9 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   const int gq = s * nx; /* the guess's stage Newton: small systems only */
   if (gq <= FESD__GN_MAX && !it->tab.is_explicit) {
     it->gn = dalloc((size_t)gq * gq + 2 * (size_t)gq + (size_t)nx * nx, &fail);
-    it->gn_jth = dalloc(it->model.pf_nnz > 0 ? (size_t)it->model.pf_nnz : 1, &fail);
+    const size_t nk = 1 + (size_t)s * (size_t)it->model.pf_nnz;
+    it->gn_key = dalloc(2 * nk, &fail);
+    it->gn_memo = it->gn_key ? it->gn_key + nk : NULL;
     it->gn_piv = malloc((size_t)gq * sizeof(int));
     if (!it->gn_piv) fail = 1;
   }

@@ -87,9 +87,12 @@ struct fesd_integrator {
   /* sensitivities */
   double *Sx, *Su, *Dtmp, *Stmp;
   double *gbuf, *blk, *vtmp; /* vtmp: 2 nx */
-  /* stage Newton of the guess (guess.c), when s nx <= FESD__GN_MAX: matrix, residual, saved
-   * stages, dense Jacobian; pivots; sum theta df/dx on the union pattern (NULL: too large) */
-  double *gn, *gn_jth;
+  /* stage Newton of the guess (stage_newton.c), when s nx <= FESD__GN_MAX: matrix (its LU),
+   * residual, saved stages, dense Jacobian; pivots; the key of an element's matrix (h, then
+   * sum theta df/dx on the union pattern per stage) and the key of the LU in gn (gn_memo,
+   * valid while gn_memo_ok; both in the block gn_key). NULL: too large */
+  double *gn, *gn_key, *gn_memo;
+  int gn_memo_ok;
   double *fil_th;         /* nth: multipliers of an alternative (verify.c) */
   unsigned char *fil_a;   /* nth: its active flags */
   int *gn_piv;

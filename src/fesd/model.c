@@ -304,31 +304,28 @@ fail:
   return st;
 }
 
+/* One block per point (g first: it owns the block), the fields' arrays only when asked for:
+ * the system keeps a few records per stage of its largest layout. */
 int fesd__point_alloc(const fesd__model *m, fesd__point_eval *pe, int fields) {
-  size_t nu = (size_t)(m->nu > 0 ? m->nu : 1);
+  const size_t nu = (size_t)(m->nu > 0 ? m->nu : 1), nth = (size_t)m->nth;
+  const size_t ndg = (size_t)(m->ndg > 0 ? m->ndg : 1), nF = (size_t)(m->nF > 0 ? m->nF : 1);
+  const size_t ndF = (size_t)(m->ndF > 0 ? m->ndF : 1), nFu = (size_t)(m->nFu > 0 ? m->nFu : 1);
   memset(pe, 0, sizeof(*pe));
-  pe->g = malloc((size_t)m->nth * sizeof(double));
-  pe->dgdx = malloc((size_t)(m->ndg > 0 ? m->ndg : 1) * sizeof(double));
-  pe->dgdu = malloc((size_t)m->nth * nu * sizeof(double));
+  double *b = malloc((nth + ndg + nth * nu + (fields ? nF + ndF + nFu : 0)) * sizeof(double));
+  if (!b) return FESD_ERR_NOMEM;
+  pe->g = b;
+  pe->dgdx = pe->g + nth;
+  pe->dgdu = pe->dgdx + ndg;
   if (fields) {
-    pe->F = malloc((size_t)(m->nF > 0 ? m->nF : 1) * sizeof(double));
-    pe->dFdx = malloc((size_t)(m->ndF > 0 ? m->ndF : 1) * sizeof(double));
-    pe->dFdu = malloc((size_t)(m->nFu > 0 ? m->nFu : 1) * sizeof(double));
-  }
-  if (!pe->g || !pe->dgdx || !pe->dgdu || (fields && (!pe->F || !pe->dFdx || !pe->dFdu))) {
-    fesd__point_free(pe);
-    return FESD_ERR_NOMEM;
+    pe->F = pe->dgdu + nth * nu;
+    pe->dFdx = pe->F + nF;
+    pe->dFdu = pe->dFdx + ndF;
   }
   return FESD_OK;
 }
 
 void fesd__point_free(fesd__point_eval *pe) {
-  free(pe->F);
   free(pe->g);
-  free(pe->dFdx);
-  free(pe->dgdx);
-  free(pe->dFdu);
-  free(pe->dgdu);
   memset(pe, 0, sizeof(*pe));
 }
 

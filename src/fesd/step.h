@@ -48,6 +48,11 @@ void fesd__poly_state(const fesd_integrator *it, const double *z, int n, const d
  * through the stage states for the other families). */
 void fesd__state_at(fesd_integrator *it, const double *z, int N, double t, double *x);
 
+/* ---- stage_newton.c ---- */
+/* Stage equations of element n (theta fixed) by Newton from the stages in z: 0 when solved to
+ * round-off (z updated), 1 otherwise (z unchanged). */
+int fesd__stage_newton(fesd_integrator *it, double *z, int n, const double *xn, double h, double tn);
+
 /* ---- guess.c ---- */
 int fesd__initial_guess(fesd_integrator *it, const double *u, double T, double *z);
 int fesd__consistent_guess(fesd_integrator *it, double *z);

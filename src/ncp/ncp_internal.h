@@ -30,6 +30,8 @@ struct fesd_ncp {
   int nb, border_dirty;
   int ready;        /* 0 after a failed re-analysis: solves return FESD_ERR_NOT_READY */
   int rows_pending; /* the selection is set but not applied yet (setup): applied at first use */
+  int defer;           /* set_rows leaves the pattern to the first Jacobian (ncp_defer.h) */
+  int pattern_pending; /* the selection's pattern is not built and analysed yet */
   int nomem;        /* FESD_ERR_NOMEM results of analyses, factorizations and solves so far */
 
   /* row selection */
@@ -81,6 +83,9 @@ static inline int fesd__ncp_note(fesd_ncp *ws, int rc) {
 int fesd__ncp_apply_rows(fesd_ncp *ws);
 /* Apply a pending selection (FESD_OK when ready, FESD_ERR_NOT_READY after a failed one). */
 int fesd__ncp_ensure_rows(fesd_ncp *ws);
+/* Build and analyse the pattern of the applied selection before its first Jacobian is
+ * assembled, when set_rows deferred it. */
+int fesd__ncp_ensure_pattern(fesd_ncp *ws);
 
 /* newton.c: callback wrapper shared with sensitivity.c */
 int fesd__ncp_call(fesd_ncp *ws, const double *z, double *raw, double *jac, fesd__ncp_stats *st);

@@ -247,6 +247,7 @@ static int stage(fesd_ncp *ws, double *z, double sigma, double tol, fesd__ncp_st
       if (rc != FESD_OK) return rc;
       ss.jac_ok = 1;
     }
+    if ((rc = fesd__ncp_ensure_pattern(ws)) != FESD_OK) return rc;
     st->iterations++;
     fesd__ncp_weights(ws, ws->raw_c, sigma);
     fesd__ncp_jacobian(ws, ws->jac_c);

@@ -97,6 +97,54 @@ int fesd__ncp_ensure_rows(fesd_ncp *ws) {
   return ws->ready ? FESD_OK : FESD_ERR_NOT_READY;
 }
 
+/* The assembly maps, the sparse pattern and the solver's analysis of the selection. */
+static int apply_pattern(fesd_ncp *ws, const int *eq_pos) {
+  const int n = ws->n;
+  ws->n_act = 0;
+  for (int t = 0; t < ws->nnz; t++) {
+    int ar = assembled_row(ws, eq_pos, ws->trow[t]);
+    if (ar < 0) continue;
+    int a = ws->n_act++;
+    ws->act_src[a] = t;
+    ws->act_wrow[a] = ws->trow[t];
+    ws->act_r[a] = ar;
+    ws->act_c[a] = ws->tcol[t];
+  }
+  int rc;
+  switch (ws->active->ops->layout) {
+  case FESD__LAYOUT_DENSE:
+    for (int a = 0; a < ws->n_act; a++) ws->act_tgt[a] = ws->act_r[a] + ws->act_c[a] * ws->m;
+    ws->nvals = ws->m * n;
+    /* the dense normal object also serves as the square fallback: keep both current */
+    rc = ws->lu->ops->analyze(ws->lu, ws->m, NULL, NULL);
+    if (rc == FESD_OK) rc = ws->normal->ops->analyze(ws->normal, ws->m, NULL, NULL);
+    break;
+  case FESD__LAYOUT_CSC:
+    build_csc(ws->m, n, ws->n_act, ws->act_r, ws->act_c, ws->sp_p, ws->sp_i, ws->act_tgt,
+              ws->work);
+    ws->nvals = ws->sp_p[n];
+    rc = ws->active->ops->analyze(ws->active, ws->m, ws->sp_p, ws->sp_i);
+    break;
+  default: /* CSC of J' */
+    build_csc(n, ws->m, ws->n_act, ws->act_c, ws->act_r, ws->sp_p, ws->sp_i, ws->act_tgt,
+              ws->work);
+    ws->nvals = ws->sp_p[ws->m];
+    rc = ws->active->ops->analyze(ws->active, ws->m, ws->sp_p, ws->sp_i);
+    break;
+  }
+  return fesd__ncp_note(ws, rc);
+}
+
+int fesd__ncp_ensure_pattern(fesd_ncp *ws) {
+  if (!ws->pattern_pending) return FESD_OK;
+  /* eq_pos of the selection, as apply_rows made it (scratch: read before build_csc uses work) */
+  int *eq_pos = ws->work;
+  for (int j = 0; j < ws->n_eq_on; j++) eq_pos[ws->eq_list[j]] = j;
+  int rc = apply_pattern(ws, eq_pos);
+  ws->pattern_pending = rc != FESD_OK; /* a failed analysis is tried again at the next use */
+  return rc;
+}
+
 int fesd__ncp_apply_rows(fesd_ncp *ws) {
   const int n = ws->n, n_eq = ws->n_eq, np = ws->n_pair;
   int *eq_pos = ws->work; /* scratch, consumed before build_csc reuses work */
@@ -155,39 +203,10 @@ int fesd__ncp_apply_rows(fesd_ncp *ws) {
     ws->active = ws->normal;
   }
 
-  ws->n_act = 0;
-  for (int t = 0; t < ws->nnz; t++) {
-    int ar = assembled_row(ws, eq_pos, ws->trow[t]);
-    if (ar < 0) continue;
-    int a = ws->n_act++;
-    ws->act_src[a] = t;
-    ws->act_wrow[a] = ws->trow[t];
-    ws->act_r[a] = ar;
-    ws->act_c[a] = ws->tcol[t];
-  }
-
-  int rc;
-  switch (ws->active->ops->layout) {
-  case FESD__LAYOUT_DENSE:
-    for (int a = 0; a < ws->n_act; a++) ws->act_tgt[a] = ws->act_r[a] + ws->act_c[a] * ws->m;
-    ws->nvals = ws->m * n;
-    /* the dense normal object also serves as the square fallback: keep both current */
-    rc = ws->lu->ops->analyze(ws->lu, ws->m, NULL, NULL);
-    if (rc == FESD_OK) rc = ws->normal->ops->analyze(ws->normal, ws->m, NULL, NULL);
-    break;
-  case FESD__LAYOUT_CSC:
-    build_csc(ws->m, n, ws->n_act, ws->act_r, ws->act_c, ws->sp_p, ws->sp_i, ws->act_tgt,
-              ws->work);
-    ws->nvals = ws->sp_p[n];
-    rc = ws->active->ops->analyze(ws->active, ws->m, ws->sp_p, ws->sp_i);
-    break;
-  default: /* CSC of J' */
-    build_csc(n, ws->m, ws->n_act, ws->act_c, ws->act_r, ws->sp_p, ws->sp_i, ws->act_tgt,
-              ws->work);
-    ws->nvals = ws->sp_p[ws->m];
-    rc = ws->active->ops->analyze(ws->active, ws->m, ws->sp_p, ws->sp_i);
-    break;
-  }
-  if (rc == FESD_OK) ws->ready = 1;
-  return fesd__ncp_note(ws, rc);
+  /* deferred: the pattern and its analysis wait for the first Jacobian (a solve that starts
+   * converged, and the residual, need only the row order) */
+  ws->pattern_pending = ws->defer;
+  int rc = ws->defer ? FESD_OK : apply_pattern(ws, eq_pos);
+  ws->ready = rc == FESD_OK;
+  return rc;
 }

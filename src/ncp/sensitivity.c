@@ -55,6 +55,7 @@ int fesd_ncp_sensitivity(fesd_ncp *ws, const double *z, double sigma, int nrhs,
   int rc_rows = fesd__ncp_ensure_rows(ws);
   if (rc_rows != FESD_OK) return rc_rows;
   if (nrhs == 0) return FESD_OK;
+  if ((rc_rows = fesd__ncp_ensure_pattern(ws)) != FESD_OK) return rc_rows;
 
   fesd__ncp_stats *st = &ws->pending;
   int rc = fesd__ncp_call(ws, z, ws->raw_c, ws->jac_c, st);

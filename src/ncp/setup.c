@@ -1,5 +1,6 @@
 /* Settings, validation, workspace allocation, row selection, bounds, cleanup. */
 #include "ncp/ncp_internal.h"
+#include "ncp/ncp_defer.h"
 #include "ncp/ncp_nomem.h"
 
 #include <limits.h>
@@ -286,3 +287,5 @@ const char *fesd_ncp_backend_name(int backend) {
 }
 
 int fesd__ncp_nomem_count(const fesd_ncp *ws) { return ws ? ws->nomem : 0; }
+
+void fesd__ncp_defer_analysis(fesd_ncp *ws) { ws->defer = 1; }

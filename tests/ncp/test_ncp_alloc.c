@@ -9,6 +9,7 @@
 #include "ncp_test_util.h"
 
 #include "../alloc_hook.h"
+#include "ncp/ncp_defer.h"
 
 #if ALLOC_HOOK_ACTIVE
 /* One scenario on an LCP with 2 extra consistent rows (so that m > n selections
@@ -80,18 +81,24 @@ static void injection(prob_t *p, int backend) {
          fesd_ncp_backend_name(backend), k, nomem, other);
 }
 
-/* A failed re-analysis leaves the workspace refusing to solve until set_rows succeeds. */
-static void not_ready_after_failed_set_rows(prob_t *p) {
-  int n = p->lcp.n;
-  fesd_ncp_problem pr = {n, 2, n, p->nnz, p->row, p->col, extra_eval, p};
+/* A KLU workspace of p (its default selection, m = n + 2, would use CHOLMOD). */
+static fesd_ncp *klu_workspace(prob_t *p) {
+  fesd_ncp_problem pr = {p->lcp.n, 2, p->lcp.n, p->nnz, p->row, p->col, extra_eval, p};
   fesd_ncp_settings s;
   fesd_ncp_settings_default(&s);
   s.backend = FESD_NCP_BACKEND_KLU;
   fesd_ncp *ws = NULL;
+  CHECK_RC(fesd_ncp_setup(&ws, &pr, &s), FESD_OK);
+  return ws;
+}
+
+/* A failed re-analysis leaves the workspace refusing to solve until set_rows succeeds. */
+static void not_ready_after_failed_set_rows(prob_t *p) {
+  const int n = p->lcp.n;
+  fesd_ncp *ws = klu_workspace(p);
   unsigned char eq_off[2] = {0, 0};
   double z[20];
   fesd_ncp_info info;
-  CHECK_RC(fesd_ncp_setup(&ws, &pr, &s), FESD_OK); /* m = n + 2: CHOLMOD */
   g_count = 0;
   g_fail_at = 0; /* the first allocation of the KLU analysis fails */
   int rc = fesd_ncp_set_rows(ws, eq_off, NULL);
@@ -103,6 +110,35 @@ static void not_ready_after_failed_set_rows(prob_t *p) {
   CHECK_RC(fesd_ncp_solve(ws, z, 0.0, &info), FESD_OK);
   printf("  failed set_rows -> %s, solve -> NOT_READY, set_rows again -> solve %s (backend %s)\n",
          fesd_status_name(rc), fesd_status_name(info.status), fesd_ncp_backend_name(info.backend));
+  fesd_ncp_free(&ws);
+}
+
+/* Deferred analysis (the integrator's workspaces): set_rows and the residual allocate nothing;
+ * a failure of the analysis at the first Jacobian is returned by that solve, and the next
+ * solve analyses again and succeeds. */
+static void deferred_analysis_retried(prob_t *p) {
+  const int n = p->lcp.n;
+  fesd_ncp *ws = klu_workspace(p);
+  unsigned char eq_off[2] = {0, 0};
+  double z[20], res;
+  fesd_ncp_info info;
+  fesd__ncp_defer_analysis(ws);
+  for (int i = 0; i < n; i++) z[i] = 1.0;
+  g_count = 0;
+  g_fail_at = -1; /* counting only */
+  CHECK_RC(fesd_ncp_set_rows(ws, eq_off, NULL), FESD_OK);
+  CHECK_RC(fesd_ncp_residual(ws, z, 0.0, NULL, &res), FESD_OK);
+  const long before = g_count;
+  g_count = 0;
+  g_fail_at = 0; /* the first allocation of the analysis fails */
+  int rc = fesd_ncp_solve(ws, z, 0.0, &info);
+  g_fail_at = -1;
+  CHECK(rc == FESD_ERR_NOMEM, "solve with a failing deferred analysis: %s", fesd_status_name(rc));
+  for (int i = 0; i < n; i++) z[i] = 1.0;
+  CHECK_RC(fesd_ncp_solve(ws, z, 0.0, &info), FESD_OK);
+  CHECK(before == 0, "deferred set_rows and residual allocated %ld blocks", before);
+  printf("  deferred: set_rows + residual %ld allocations, failed analysis -> %s, next solve %s\n", before,
+         fesd_status_name(rc), fesd_status_name(info.status));
   fesd_ncp_free(&ws);
 }
 
@@ -161,6 +197,7 @@ int main(void) {
   for (int b = 0; b < 4; b++) injection(&p, backends[b]);
   printf("Recovery from a failed re-analysis\n");
   not_ready_after_failed_set_rows(&p);
+  deferred_analysis_retried(&p);
   printf("Allocations while solving (after the first solve of a selection)\n");
   no_alloc_in_solve(&p, FESD_NCP_BACKEND_DENSE, 1);
   no_alloc_in_solve(&p, FESD_NCP_BACKEND_KLU, 1);
