@@ -54,6 +54,9 @@ typedef int (*fesd_ocp_fn)(double t, const double *x, const double *u, double *v
                            void *user);
 
 /** Optimal control problem. Arrays are copied by fesd_ocp_create(). */
+/** Longest merit memory of the line search (settings.nonmonotone). */
+#define FESD_OCP_MAX_NONMONOTONE 16
+
 typedef struct {
   const fesd_model *model;   /**< dynamics (required; dense models: sparsity must be NULL) */
   int n_ctrl;                /**< control intervals N, [1, 100000] */
@@ -126,6 +129,13 @@ typedef struct {
   int max_backtracks;        /**< trials per line search, [1, 60] (default 30) */
   int soc;                   /**< second-order correction when the full step is rejected,
                                   0 or 1 (default 1) */
+  int nonmonotone;           /**< merit memory of the line search in the local phase (after 3
+                                  consecutive full steps, with a shrinking step): a trial point
+                                  is compared with the largest l1 merit of the last `nonmonotone`
+                                  iterates (the current one included, all with the current
+                                  penalty), so a full step that raises the merit slightly (the
+                                  Maratos effect) is taken without a second-order correction;
+                                  [1, FESD_OCP_MAX_NONMONOTONE]; 1: monotone (default 2) */
   double reg_primal;         /**< proximal term of the QP Hessian (relative to its largest
                                   diagonal entry, at least 1e-12 absolute), [0, 1] (default 1e-9) */
   double reg_dual;           /**< proximal term of the QP multipliers (keeps degenerate QPs

@@ -88,6 +88,9 @@ struct fesd_ocp {
   double *w_best, *y_best;  /* the returned iterate and its multipliers */
   double *wg;               /* start of the next solve */
   double best_score;
+  /* the last settings.nonmonotone iterates' objective and violation (line search reference) */
+  double hist_f[FESD_OCP_MAX_NONMONOTONE], hist_v[FESD_OCP_MAX_NONMONOTONE];
+  int hist_n;
   int have_guess;           /* wg is set (by fesd_ocp_set_guess or a previous solve) */
   int warm;                 /* y_best holds multipliers of wg (a previous solve) */
   /* multipliers in the user's layout */

@@ -21,6 +21,7 @@ int fesd_ocp_settings_default(fesd_ocp_settings *s) {
   s->backtrack = 0.5;
   s->max_backtracks = 30;
   s->soc = 1;
+  s->nonmonotone = 2;
   s->reg_primal = 1e-9;
   s->reg_dual = 1e-10;
   s->qp_tol = 1e-12;
@@ -41,7 +42,8 @@ static int check_settings(const fesd_ocp_settings *s) {
       !open_in(s->armijo, 0, 0.5) || !in(s->backtrack, 0.05, 0.95) || s->max_backtracks < 1 ||
       s->max_backtracks > 60 || (s->soc != 0 && s->soc != 1) || !in(s->reg_primal, 0, 1) ||
       !in(s->reg_dual, 0, 1) || !in(s->qp_tol, 1e-15, 1e-3) || s->qp_max_iter < 1 || s->qp_max_iter > 1000 ||
-      s->stall_window < 0 || s->stall_window > 1000 ||
+      s->stall_window < 0 || s->stall_window > 1000 || s->nonmonotone < 1 ||
+      s->nonmonotone > FESD_OCP_MAX_NONMONOTONE ||
       (int)s->qp_backend < 0 || (int)s->qp_backend > FESD_NCP_BACKEND_CHOLMOD ||
       !(s->init == FESD_OCP_INIT_SIMULATE || s->init == FESD_OCP_INIT_CONSTANT) || (s->verbose != 0 && s->verbose != 1))
     return FESD_ERR_INVALID_ARG;
