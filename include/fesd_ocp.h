@@ -101,7 +101,10 @@ typedef enum {
 } fesd_ocp_hessian;
 
 typedef enum {
-  FESD_OCP_INIT_SIMULATE = 0, /**< x_k from a forward simulation with the control guess */
+  FESD_OCP_INIT_SIMULATE = 0, /**< x_k from a forward simulation with the control guess, then
+                                   clamped to the bounds (run by the solve's first evaluation,
+                                   which integrates the intervals anyway; a failed interval keeps
+                                   the state constant) */
   FESD_OCP_INIT_CONSTANT = 1  /**< x_k = x0 for all k */
 } fesd_ocp_init;
 
@@ -170,7 +173,7 @@ typedef struct {
   int hessian_skipped;      /**< ... skipped (tiny step, too little curvature, SR1 denominator) */
   int hessian_resets;       /**< quasi-Newton restarts (BFGS after a failed line search, SR1
                                  correction after a backtracking one) */
-  int integrations;         /**< interval simulations (fesd_step calls) */
+  int integrations;         /**< interval simulations (fesd_step calls), the guess's included */
   int integrator_failures;  /**< interval simulations that failed (trial points rejected) */
   int integrator_flags;     /**< FESD_FLAG_* bits seen at the returned iterate */
   double objective;         /**< f at the returned iterate */

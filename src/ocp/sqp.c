@@ -318,11 +318,13 @@ int fesd_ocp_solve(fesd_ocp *o, fesd_ocp_info *info) {
   int st = FESD_OK;
   if (!o->have_guess) st = fesd_ocp_set_guess(o, NULL, NULL);
   memcpy(o->cur->w, o->wg, (size_t)o->nw * sizeof(double));
-  memcpy(o->w_best, o->wg, (size_t)o->nw * sizeof(double));
   memcpy(o->y, o->y_best, (size_t)m * sizeof(double)); /* zero unless warm */
   o->best_score = INFINITY;
   memset(&o->best_info, 0, sizeof(o->best_info));
-  if (!st) st = fesd__ocp_eval(o, o->cur);
+  if (!st) st = o->guess_pending ? fesd__ocp_eval_guess(o, o->cur) : fesd__ocp_eval(o, o->cur);
+  if (o->guess_pending) memcpy(o->wg, o->cur->w, (size_t)o->nw * sizeof(double)); /* the simulated guess */
+  o->guess_pending = 0;
+  memcpy(o->w_best, o->wg, (size_t)o->nw * sizeof(double));
   if (!st) {
     fesd__ocp_hessian_reset(o);
     fesd__ocp_sr1_reset(o);
