@@ -54,6 +54,9 @@ typedef int (*fesd_ocp_fn)(double t, const double *x, const double *u, double *v
                            void *user);
 
 /** Optimal control problem. Arrays are copied by fesd_ocp_create(). */
+/** Longest merit memory of the line search (settings.nonmonotone). */
+#define FESD_OCP_MAX_NONMONOTONE 16
+
 typedef struct {
   const fesd_model *model;   /**< dynamics (required; dense models: sparsity must be NULL) */
   int n_ctrl;                /**< control intervals N, [1, 100000] */
@@ -98,7 +101,10 @@ typedef enum {
 } fesd_ocp_hessian;
 
 typedef enum {
-  FESD_OCP_INIT_SIMULATE = 0, /**< x_k from a forward simulation with the control guess */
+  FESD_OCP_INIT_SIMULATE = 0, /**< x_k from a forward simulation with the control guess, then
+                                   clamped to the bounds (run by the solve's first evaluation,
+                                   which integrates the intervals anyway; a failed interval keeps
+                                   the state constant) */
   FESD_OCP_INIT_CONSTANT = 1  /**< x_k = x0 for all k */
 } fesd_ocp_init;
 
@@ -126,6 +132,13 @@ typedef struct {
   int max_backtracks;        /**< trials per line search, [1, 60] (default 30) */
   int soc;                   /**< second-order correction when the full step is rejected,
                                   0 or 1 (default 1) */
+  int nonmonotone;           /**< merit memory of the line search in the local phase (after 3
+                                  consecutive full steps, with a shrinking step): a trial point
+                                  is compared with the largest l1 merit of the last `nonmonotone`
+                                  iterates (the current one included, all with the current
+                                  penalty), so a full step that raises the merit slightly (the
+                                  Maratos effect) is taken without a second-order correction;
+                                  [1, FESD_OCP_MAX_NONMONOTONE]; 1: monotone (default 2) */
   double reg_primal;         /**< proximal term of the QP Hessian (relative to its largest
                                   diagonal entry, at least 1e-12 absolute), [0, 1] (default 1e-9) */
   double reg_dual;           /**< proximal term of the QP multipliers (keeps degenerate QPs
@@ -160,7 +173,7 @@ typedef struct {
   int hessian_skipped;      /**< ... skipped (tiny step, too little curvature, SR1 denominator) */
   int hessian_resets;       /**< quasi-Newton restarts (BFGS after a failed line search, SR1
                                  correction after a backtracking one) */
-  int integrations;         /**< interval simulations (fesd_step calls) */
+  int integrations;         /**< interval simulations (fesd_step calls), the guess's included */
   int integrator_failures;  /**< interval simulations that failed (trial points rejected) */
   int integrator_flags;     /**< FESD_FLAG_* bits seen at the returned iterate */
   double objective;         /**< f at the returned iterate */

@@ -79,10 +79,34 @@ static int gn_interval(fesd_ocp *o, ocp_point *pt, int k) {
   return FESD_OK;
 }
 
-int fesd__ocp_eval(fesd_ocp *o, ocp_point *pt) {
+/* The end of the guess's chain x_{k+1} = Phi_k(x_k, q_k) (evaluate with chain): after a failed
+ * interval the state stays constant; then every state is clamped to its bounds (returns 1 when
+ * one moved by more than round-off: the intervals were integrated from the unclamped states,
+ * not at the guess; ocp_step_eq's guess reaches |v| = 2 at k = 3 and overshoots by 1 ulp) and
+ * the L1 slacks are set at |r1(x_N)|. */
+static int chain_end(fesd_ocp *o, ocp_point *pt, int failed_at) {
+  const int nx = o->nx, nb = o->nb, N = o->N, cN = N * nb;
+  double *w = pt->w;
+  for (int k = failed_at + 1; k <= N; k++) memcpy(w + k * nb, w + (k - 1) * nb, (size_t)nx * sizeof(double));
+  int clamped = 0;
+  for (int j = nb; j < cN + nx; j++) {
+    const double v = w[j] < o->lb[j] ? o->lb[j] : w[j] > o->ub[j] ? o->ub[j] : w[j];
+    clamped |= fabs(v - w[j]) > 1e-14 * (1 + fabs(v)); /* more than round-off */
+    w[j] = v;
+  }
+  if (o->p.n_l1 > 0) {
+    int st = fesd__ocp_call(o, o->p.l1, o->p.n_l1, o->p.tf, w + cN, NULL, 0);
+    if (st) return st;
+    for (int i = 0; i < o->p.n_l1; i++) w[cN + nx + i] = fabs(o->fv[i]);
+  }
+  return clamped;
+}
+
+/* Everything at pt->w; chain: the guess, whose states are simulated on the way. */
+static int evaluate(fesd_ocp *o, ocp_point *pt, int chain) {
   const fesd_ocp_problem *p = &o->p;
   const int nx = o->nx, nu = o->nu, na = o->nxa, nb = o->nb, N = o->N, cN = N * nb;
-  const double *w = pt->w;
+  double *w = pt->w;
   double *g = pt->grad;
   int st;
   memset(g, 0, (size_t)o->nw * sizeof(double));
@@ -91,7 +115,11 @@ int fesd__ocp_eval(fesd_ocp *o, ocp_point *pt) {
   for (int k = 0; k < N; k++) {
     double l;
     st = fesd__ocp_simulate(o, k, w + k * nb, w + k * nb + nx, pt->phi + (size_t)k * nx, &l, 1, &pt->flags);
-    if (st) return st;
+    if (st) {
+      if (chain && st != FESD_ERR_NOMEM) chain_end(o, pt, k);
+      return st;
+    }
+    if (chain) memcpy(w + (k + 1) * nb, pt->phi + (size_t)k * nx, (size_t)nx * sizeof(double));
     double *Sx = pt->Sx + (size_t)k * nx * nx, *Su = pt->Su + (size_t)k * nx * nu;
     for (int j = 0; j < nx; j++) memcpy(Sx + (size_t)j * nx, o->Sxa + (size_t)j * na, (size_t)nx * sizeof(double));
     for (int j = 0; j < nu; j++) memcpy(Su + (size_t)j * nx, o->Sua + (size_t)j * na, (size_t)nx * sizeof(double));
@@ -102,6 +130,7 @@ int fesd__ocp_eval(fesd_ocp *o, ocp_point *pt) {
     }
     if (o->nL > 0 && (st = gn_interval(o, pt, k))) return st;
   }
+  if (chain && (st = chain_end(o, pt, N))) return st;
   if (p->mayer) {
     if ((st = fesd__ocp_call(o, p->mayer, 1, p->tf, w + cN, NULL, 1))) return st;
     pt->f += o->fv[0];
@@ -122,6 +151,13 @@ int fesd__ocp_eval(fesd_ocp *o, ocp_point *pt) {
   if ((st = fesd__ocp_emit(o, pt, EMIT_VALUES))) return st;
   pt->viol = fesd__ocp_violation(o, pt->c);
   return FESD_OK;
+}
+
+int fesd__ocp_eval(fesd_ocp *o, ocp_point *pt) { return evaluate(o, pt, 0); }
+
+int fesd__ocp_eval_guess(fesd_ocp *o, ocp_point *pt) {
+  const int st = evaluate(o, pt, 1);
+  return st == 1 ? evaluate(o, pt, 0) : st; /* clamped: at the guess again */
 }
 
 double fesd__ocp_violation(const fesd_ocp *o, const double *c) {

@@ -88,7 +88,11 @@ struct fesd_ocp {
   double *w_best, *y_best;  /* the returned iterate and its multipliers */
   double *wg;               /* start of the next solve */
   double best_score;
+  /* the last settings.nonmonotone iterates' objective and violation (line search reference) */
+  double hist_f[FESD_OCP_MAX_NONMONOTONE], hist_v[FESD_OCP_MAX_NONMONOTONE];
+  int hist_n;
   int have_guess;           /* wg is set (by fesd_ocp_set_guess or a previous solve) */
+  int guess_pending;        /* wg's states are to be simulated by the solve's first evaluation */
   int warm;                 /* y_best holds multipliers of wg (a previous solve) */
   /* multipliers in the user's layout */
   double *m_dyn, *m_x0, *m_xb, *m_ub, *m_path, *m_term, *m_l1;
@@ -107,6 +111,11 @@ int fesd__ocp_emit(fesd_ocp *o, ocp_point *pt, int mode);
 
 /* eval.c */
 int fesd__ocp_eval(fesd_ocp *o, ocp_point *pt);       /* everything at pt->w */
+/* the same at the guess whose states are simulated on the way (fesd_ocp_set_guess without
+ * states, settings.init SIMULATE): pt->w holds x_0 and the controls; the states (simulated,
+ * then clamped to their bounds: evaluated again when that moved one) and the L1 slacks are
+ * written */
+int fesd__ocp_eval_guess(fesd_ocp *o, ocp_point *pt);
 int fesd__ocp_simulate(fesd_ocp *o, int k, const double *s, const double *q, double *xend, double *l,
                        int sens, int *flags);
 void fesd__ocp_lagrangian_grad(const fesd_ocp *o, const ocp_point *pt, const double *mult, double *out);

@@ -21,6 +21,7 @@ int fesd_ocp_settings_default(fesd_ocp_settings *s) {
   s->backtrack = 0.5;
   s->max_backtracks = 30;
   s->soc = 1;
+  s->nonmonotone = 2;
   s->reg_primal = 1e-9;
   s->reg_dual = 1e-10;
   s->qp_tol = 1e-12;
@@ -41,7 +42,8 @@ static int check_settings(const fesd_ocp_settings *s) {
       !open_in(s->armijo, 0, 0.5) || !in(s->backtrack, 0.05, 0.95) || s->max_backtracks < 1 ||
       s->max_backtracks > 60 || (s->soc != 0 && s->soc != 1) || !in(s->reg_primal, 0, 1) ||
       !in(s->reg_dual, 0, 1) || !in(s->qp_tol, 1e-15, 1e-3) || s->qp_max_iter < 1 || s->qp_max_iter > 1000 ||
-      s->stall_window < 0 || s->stall_window > 1000 ||
+      s->stall_window < 0 || s->stall_window > 1000 || s->nonmonotone < 1 ||
+      s->nonmonotone > FESD_OCP_MAX_NONMONOTONE ||
       (int)s->qp_backend < 0 || (int)s->qp_backend > FESD_NCP_BACKEND_CHOLMOD ||
       !(s->init == FESD_OCP_INIT_SIMULATE || s->init == FESD_OCP_INIT_CONSTANT) || (s->verbose != 0 && s->verbose != 1))
     return FESD_ERR_INVALID_ARG;
@@ -266,26 +268,17 @@ int fesd_ocp_set_guess(fesd_ocp *o, const double *x, const double *u) {
   for (int k = 0; k < N; k++)
     for (int i = 0; i < nu; i++) w[k * nb + nx + i] = u ? u[k * nu + i] : 0.0;
   for (int i = 0; i < nx; i++) w[i] = x && o->x0_free[i] ? x[i] : o->x0[i];
-  for (int k = 1; k <= N; k++) {
-    double *xk = w + k * nb;
-    const double *xp = w + (k - 1) * nb;
-    if (x) {
-      memcpy(xk, x + (size_t)k * nx, (size_t)nx * sizeof(double));
-    } else if (o->set.init == FESD_OCP_INIT_SIMULATE) {
-      double l;
-      /* a failed interval keeps the state constant (the SQP repairs what is infeasible) */
-      if (fesd__ocp_simulate(o, k - 1, xp, xp + nx, xk, &l, 0, NULL))
-        memcpy(xk, xp, (size_t)nx * sizeof(double));
-    } else {
-      memcpy(xk, o->x0, (size_t)nx * sizeof(double));
-    }
-  }
+  /* simulated states: by the solve's first evaluation, which integrates the intervals anyway
+   * (eval.c: a failed interval keeps the state constant; the SQP repairs what is infeasible) */
+  const int simulate = !x && o->set.init == FESD_OCP_INIT_SIMULATE;
+  for (int k = 1; k <= N; k++) memcpy(w + k * nb, x ? x + (size_t)k * nx : o->x0, (size_t)nx * sizeof(double));
   for (int j = 0; j < cN + nx; j++) {
     if (!isfinite(w[j])) return FESD_ERR_INVALID_ARG;
     w[j] = clampd(w[j], o->lb[j], o->ub[j]);
   }
+  o->guess_pending = simulate;
   /* L1 slacks at |r1(x_N)| */
-  if (o->p.n_l1 > 0) {
+  if (o->p.n_l1 > 0 && !simulate) {
     int st = fesd__ocp_call(o, o->p.l1, o->p.n_l1, o->p.tf, w + cN, NULL, 0);
     if (st) return st;
     for (int i = 0; i < o->p.n_l1; i++) w[cN + nx + i] = fabs(o->fv[i]);

@@ -52,7 +52,7 @@ int main(void) {
   fesd_ocp_free(NULL);
 
   /* settings out of range */
-  for (int c = 0; c < 16; c++) {
+  for (int c = 0; c < 18; c++) {
     fesd_ocp_settings_default(&s);
     switch (c) {
     case 0: s.max_iter = 0; break;
@@ -71,6 +71,8 @@ int main(void) {
     case 13: s.hessian = (fesd_ocp_hessian)7; break;
     case 14: s.init = (fesd_ocp_init)3; break;
     case 15: s.verbose = 2; break;
+    case 16: s.nonmonotone = 0; break;
+    case 17: s.nonmonotone = FESD_OCP_MAX_NONMONOTONE + 1; break;
     }
     int st = fesd_ocp_create(&o, &good, &s);
     CHECK(st == FESD_ERR_INVALID_ARG && !o, "setting case %d: %s", c, fesd_status_name(st));

@@ -183,6 +183,18 @@ int main(void) {
   CHECK(st == FESD_OK && fabs(info.objective - f_sr1) <= 1e-8 * fabs(f_sr1), "GN: %s, f = %.12f vs %.12f",
         fesd_status_name(st), info.objective, f_sr1);
   fesd_ocp_free(&o);
+
+  /* the monotone line search (no merit memory) reaches the same KKT point */
+  s.hessian = FESD_OCP_HESSIAN_AUTO;
+  s.nonmonotone = 1;
+  CHECK(fesd_ocp_create(&o, &op, &s) == FESD_OK, "create monotone");
+  fesd_ocp_set_guess(o, NULL, ug);
+  st = fesd_ocp_solve(o, &info);
+  printf("FESD monotone line search: %s, %d iterations, %d integrations, f = %.10f\n", fesd_status_name(st),
+         info.iterations, info.integrations, info.objective);
+  CHECK(st == FESD_OK && fabs(info.objective - f_sr1) <= 1e-8 * fabs(f_sr1), "monotone: %s, f = %.12f vs %.12f",
+        fesd_status_name(st), info.objective, f_sr1);
+  fesd_ocp_free(&o);
   if (fails) printf("%d check(s) failed\n", fails);
   return fails ? 1 : 0;
 }
