@@ -245,15 +245,17 @@ static int eval_on_path(fesd_integrator *it, const double *z, double t, fesd__po
  * t on the solution's collocation polynomial. */
 static int lambda_on_path(fesd_integrator *it, const double *z, double t, const unsigned char *P, int j,
                           double *out) {
-  fesd__point_eval pe;
-  int st = eval_on_path(it, z, t, &pe);
+  fesd__system *S = &it->sys;
+  double *x = it->gbuf + it->nth, *g = it->pscr.g; /* indicators only: no fields, no Jacobians */
+  fesd__state_at(it, z, S->N, t, x);
+  int st = fesd__model_g(&it->model, S->t0 + t, x, S->u, g);
   if (st) return st;
   const fesd__model *m = &it->model;
   const int k = m->sys_of[j];
   double gmin = INFINITY;
   for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++)
-    if (P[i] && pe.g[i] < gmin) gmin = pe.g[i];
-  *out = pe.g[j] - gmin;
+    if (P[i] && g[i] < gmin) gmin = g[i];
+  *out = g[j] - gmin;
   return FESD_OK;
 }
 
