@@ -19,16 +19,18 @@
 #include "hard_util.h"
 #include "problems/friction_chain.h"
 
+#define NMAX 256 /* largest chain of the test */
+
 typedef struct {
   int st, n_ev, steps_done, iters, iters_sw, worst_iter, worst_ev; /* iters_sw: of the steps holding events */
   int splits; /* halvings */
-  double x[2 * 256];
+  double x[2 * NMAX];
   int ev_sys[4096], ev_kind[4096];
 } chain_run;
 
 static int run_chain(int n, double T, fesd_rk_family fam, int s, double h, chain_run *r) {
   fesd_friction_chain fc;
-  if (fesd_friction_chain_stick_slip(&fc, n)) return -1;
+  if (n > NMAX || fesd_friction_chain_stick_slip(&fc, n)) return -1;
   fesd_settings set;
   fesd_settings_default(&set);
   set.family = fam;
@@ -65,10 +67,10 @@ static int run_chain(int n, double T, fesd_rk_family fam, int s, double h, chain
  * (subsystem, kind) (the chain's events are well separated in time, so this is the order). */
 static int same_events(const chain_run *a, const chain_run *b) {
   if (a->n_ev != b->n_ev) return 0;
-  int cnt[2 * 64 * 4] = {0};
+  int cnt[NMAX * 4] = {0}; /* (subsystem, kind) with kinds 0..3 */
   for (int e = 0; e < a->n_ev; e++) cnt[a->ev_sys[e] * 4 + a->ev_kind[e]]++;
   for (int e = 0; e < b->n_ev; e++) cnt[b->ev_sys[e] * 4 + b->ev_kind[e]]--;
-  for (int q = 0; q < 2 * 64 * 4; q++)
+  for (int q = 0; q < NMAX * 4; q++)
     if (cnt[q]) return 0;
   return 1;
 }
