@@ -53,10 +53,7 @@ int fesd__update_lambda00(fesd_integrator *it, const double *x, const double *u,
 static int start_jump(fesd_integrator *it, const double *z, int k) {
   fesd__model *m = &it->model;
   const int nx = m->nx, nu = m->nu, nth = m->nth, a = it->jump_in[k], b = it->jump_out[k];
-  fesd__point_eval pe = {0};
-  pe.F = it->pscr.F;
-  pe.g = it->pscr.g;
-  pe.dgdx = it->pscr.dgdx;
+  fesd__point_eval pe = fesd__scratch_eval(it);
   pe.dgdu = nu > 0 ? it->pscr.dgdu : NULL;
   int st = fesd__model_eval(m, it->t, it->x, it->sys.u, &pe);
   if (st) return st;

@@ -37,10 +37,7 @@ void fesd__act_from_theta(const fesd_integrator *it, const double *theta, unsign
 static int resolve_ties(fesd_integrator *it, const double *u, unsigned char *a, int *nonunique) {
   fesd__model *m = &it->model;
   const int nx = m->nx, nth = m->nth;
-  fesd__point_eval pe = {0};
-  pe.F = it->pscr.F;
-  pe.g = it->pscr.g;
-  pe.dgdx = it->pscr.dgdx;
+  fesd__point_eval pe = fesd__scratch_eval(it);
   int st = fesd__model_eval(m, it->t, it->x, u, &pe);
   if (st) return st;
   double *ftot = it->gbuf + nth, *f = it->vtmp; /* nx each */

@@ -73,10 +73,7 @@ int fesd__error_estimate(fesd_integrator *it, const double *z, double rtol, cons
   const int nx = S->nx, s = S->s, nth = S->nth;
   *err = 0;
   if (!it->err_ok) return FESD_OK;
-  fesd__point_eval pe = {0};
-  pe.F = it->pscr.F;
-  pe.g = it->pscr.g;
-  pe.dgdx = it->pscr.dgdx;
+  fesd__point_eval pe = fesd__scratch_eval(it);
   double tn = S->t0, *f0 = it->ftot, *th0 = it->gbuf; /* nth */
   for (int n = 0; n < S->N; n++) {
     const double h = z[S->ho[n]], *xn = n == 0 ? S->x0 : z + S->xo[n - 1], *x1 = z + S->xo[n];

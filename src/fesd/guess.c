@@ -235,10 +235,7 @@ int fesd__regrid_guess(fesd_integrator *it, const double *zp, int Np, double *z)
   const int nx = S->nx, nth = S->nth, s = S->s;
   double *X = S->X; /* scratch: one state */
   fesd__system_points_stale(S);
-  fesd__point_eval pe = {0};
-  pe.F = it->pscr.F;
-  pe.g = it->pscr.g;
-  pe.dgdx = it->pscr.dgdx;
+  fesd__point_eval pe = fesd__scratch_eval(it);
   double tn = 0;
   for (int n = 0; n < S->N; n++) {
     const double h = z[S->ho[n]];

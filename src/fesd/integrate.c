@@ -59,10 +59,7 @@ static void error_tolerances(fesd_integrator *it) {
  * (weighted norms), at most the interval; the controller adapts from there. */
 static double first_step(fesd_integrator *it, const double *u, double span) {
   fesd__model *m = &it->model;
-  fesd__point_eval pe = {0};
-  pe.F = it->pscr.F;
-  pe.g = it->pscr.g;
-  pe.dgdx = it->pscr.dgdx;
+  fesd__point_eval pe = fesd__scratch_eval(it);
   double *th = it->gbuf;
   if (it->have_prev_theta) {
     memcpy(th, it->theta_prev, (size_t)it->nth * sizeof(double));

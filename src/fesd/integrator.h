@@ -171,6 +171,16 @@ struct fesd_integrator {
   double sum_iter_ord, sum_iter_sw;
 };
 
+/* A model evaluation into the scratch buffers: fields, indicators and their state gradients
+ * (valid until the next use of the scratch). */
+static inline fesd__point_eval fesd__scratch_eval(const fesd_integrator *it) {
+  fesd__point_eval pe = {0};
+  pe.F = it->pscr.F;
+  pe.g = it->pscr.g;
+  pe.dgdx = it->pscr.dgdx;
+  return pe;
+}
+
 /* w_j = int_0^tau l_j (Lagrange basis on the nodes c): the collocation polynomial of an
  * element is x_n + h sum_j w_j(tau) v_j. w has s entries. */
 void fesd__colloc_weights(const fesd_integrator *it, double tau, double *w);

@@ -230,10 +230,7 @@ static int eval_on_path(fesd_integrator *it, const double *z, double t, fesd__po
   fesd__system *S = &it->sys;
   double *x = it->gbuf + it->nth;
   fesd__state_at(it, z, S->N, t, x);
-  *pe = (fesd__point_eval){0};
-  pe->F = it->pscr.F;
-  pe->g = it->pscr.g;
-  pe->dgdx = it->pscr.dgdx;
+  *pe = fesd__scratch_eval(it);
   return fesd__model_eval(&it->model, S->t0 + t, x, S->u, pe);
 }
 

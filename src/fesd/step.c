@@ -246,10 +246,7 @@ static int candidates(fesd_integrator *it, const fesd__violation *v, const unsig
   for (int i = k0; i < k1; i++)
     if (cur[i] && i_old < 0) i_old = i;
   if (i_old < 0) return 0;
-  fesd__point_eval pe = {0};
-  pe.F = it->pscr.F;
-  pe.g = it->pscr.g;
-  pe.dgdx = it->pscr.dgdx;
+  fesd__point_eval pe = fesd__scratch_eval(it);
   if (fesd__model_eval(&it->model, t, x, it->sys.u, &pe)) return 0;
   double ai, aj;
   fesd__total_field(it, &pe, theta, it->ftot);

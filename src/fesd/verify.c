@@ -299,10 +299,7 @@ static int scan_filippov(fesd_integrator *it, const double *z, const unsigned ch
   fesd__system *S = &it->sys;
   fesd__model *m = &it->model;
   const int nth = S->nth, s = S->s;
-  fesd__point_eval pe = {0};
-  pe.F = it->pscr.F;
-  pe.g = it->pscr.g;
-  pe.dgdx = it->pscr.dgdx;
+  fesd__point_eval pe = fesd__scratch_eval(it);
   double tn = 0;
   for (int n = 0; n < S->N; n++) {
     const double h = z[S->ho[n]];
@@ -352,10 +349,7 @@ static int scan_interior(fesd_integrator *it, const double *z, const unsigned ch
   fesd__model *m = &it->model;
   const int s = S->s, nth = S->nth;
   double *x = it->gbuf + nth;
-  fesd__point_eval pe = {0};
-  pe.F = it->pscr.F;
-  pe.g = it->pscr.g;
-  pe.dgdx = it->pscr.dgdx;
+  fesd__point_eval pe = fesd__scratch_eval(it);
   double tn = 0;
   for (int n = 0; n < S->N; n++) {
     const double h = z[S->ho[n]];
