@@ -65,8 +65,13 @@ void fesd__stage_theta(fesd_integrator *it, const fesd__point_eval *pe, const un
  * Filippov's multiplier at the state), lambda and mu from the indicators. */
 int fesd__regrid_guess(fesd_integrator *it, const double *zp, int Np, double *z);
 
-/* ---- predict.c (FB fallback path) ---- */
+/* ---- predict.c (FB fallback path; entry times of the plan path) ---- */
 int fesd__predict_switches(fesd_integrator *it, const double *z, double T, double *tc, int max_c);
+/* Plan path: the time at which mode v->mode enters, the first zero of its lambda against the
+ * set P of its subsystem on the collocation polynomial of z inside the scan's bracket
+ * (v->lo, v->hi); *t unchanged when the polynomial shows no sign change there. */
+int fesd__refine_entry(fesd_integrator *it, const double *z, const fesd__violation *v, const unsigned char *P,
+                       double *t);
 int fesd__resort_guess(fesd_integrator *it, const double *zsrc, double T, const double *tc, int nc,
                        int *sw_at, double *z);
 
