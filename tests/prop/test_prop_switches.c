@@ -11,10 +11,14 @@
  *     an x(T) error within what the method's order allows on the elements FESD actually used:
  *     err <= 30 max(err_fine, 1e-8) (h_max / h_max_fine)^p, err_fine from steps of T/64,
  *     p = 2s - 1; and
- *     the error must decrease at about the method's order between steps T/32 and T/64
- *     (observed order >= p - 1, unless both errors are below 1e-8: the Newton tolerance 1e-12
- *     over approach rates down to 0.05 moves each switch by up to ~1e-10); so must the event
- *     times (order >= p - 1; sliding exits, whose times converge at order s: >= s - 1).
+ *     the error must decrease at about the method's order between steps T/32 and T/64, or,
+ *     where that pair is not yet asymptotic, between T/64 and T/128 (observed order >= p - 1,
+ *     unless both errors are below 1e-8: the Newton tolerance 1e-12 over approach rates down
+ *     to 0.05 moves each switch by up to ~1e-10); so must the event times (order >= p - 1;
+ *     sliding exits, whose times converge at order s: >= s - 1). (With three other seeds the
+ *     first pair alone failed 9 checks on 7 of 57 systems, e.g. errors 2.1e-7, 4.0e-7, 3.0e-8,
+ *     3.5e-9, 4.0e-10 at T/32 .. T/512: order 3 from T/64 on; with the second pair, seeds
+ *     1..5 pass.)
  * Arguments: none: everything; --guard: leave out what fails today (systems that reach a surface
  * while another subsystem slides; long steps of affine systems with sliding exits), so that the
  * rest guards against regressions; --known: only those. See tests/prop/meson.build. */
@@ -130,6 +134,13 @@ static double terr(const pr_run *r, const pwa_result *ref, int exit) {
   return e;
 }
 
+/* The run with steps T/128, made once per system and s (the order's second pair). */
+static int ladder(const fesd_model *m, const fesd_settings *set, const double *x0, pr_run *r, int *have) {
+  if (!*have) run_hmax(m, set, x0, 128, r);
+  *have = 1;
+  return r->status;
+}
+
 static double xerr(const pwa_sys *S, const pr_run *r, const pwa_result *ref) {
   double e = 0;
   for (int q = 0; q < S->nx; q++) e = fmax(e, fabs(r->x[q] - ref->x[q]));
@@ -147,7 +158,7 @@ static int part_b(int mode) {
       {{"several sliding", 1, 2, 4, 2, 4, 0, 0, 0.6, 0.6, 3, 3, 1, 0, 1}, 4, 1},
   };
   int n_sys = 0, draws = 0, runs = 0, failed = 0, wrong_events = 0, order_checked = 0, order_floor = 0, n_steps = 0;
-  int coarse_flagged = 0;
+  int coarse_flagged = 0, later_pair = 0; /* orders read on T/64 -> T/128 */
   long ev_in_steps = 0;
   double worst_ratio = 0, min_order[2] = {INFINITY, INFINITY};
   double min_t_order[2][2] = {{INFINITY, INFINITY}, {INFINITY, INFINITY}};
@@ -171,8 +182,9 @@ static int part_b(int mode) {
         fesd_settings set;
         fesd_settings_default(&set);
         set.stages = s;
-        static pr_run r, rf, rff;
+        static pr_run r, rf, rff, rfh;
         double dt;
+        int have_h = 0; /* rfh (steps T/128) computed */
         /* fine steps: the order, and the error constant for the long steps */
         const double hf = run_hmax(&pm.m, &set, x0, 64, &rf);
         run_hmax(&pm.m, &set, x0, 32, &rff);
@@ -188,7 +200,12 @@ static int part_b(int mode) {
             continue;
           }
           if (eff > 1e-8 || ef > 1e-8) {
-            const double q = log(eff / ef) / log(2.0);
+            double q = log(eff / ef) / log(2.0);
+            if (q < p - 1 && ladder(&pm.m, &set, x0, &rfh, &have_h) == FESD_OK && pr_same_events(&rfh, &ref, &dt)) {
+              const double eh = xerr(&S, &rfh, &ref);
+              q = fmax(q, ef <= 1e-8 && eh <= 1e-8 ? INFINITY : log(ef / eh) / log(2.0));
+              later_pair++;
+            }
             order_checked++;
             min_order[s - 2] = fmin(min_order[s - 2], q);
             FESD_TEST_CHECK(q >= p - 1, "B: %s system %d, s=%d: error %.2e (T/32) -> %.2e (T/64): order %.2f < %d",
@@ -201,7 +218,12 @@ static int part_b(int mode) {
           for (int ex = 0; ex <= 1; ex++) {
             const double a = terr(&rff, &ref, ex), b = terr(&rf, &ref, ex), want_q = ex ? s - 1 : p - 1;
             if (a <= 1e-8 && b <= 1e-8) continue;
-            const double q = log(a / b) / log(2.0);
+            double q = log(a / b) / log(2.0);
+            if (q < want_q && ladder(&pm.m, &set, x0, &rfh, &have_h) == FESD_OK && pr_same_events(&rfh, &ref, &dt)) {
+              const double c = terr(&rfh, &ref, ex);
+              q = fmax(q, b <= 1e-8 && c <= 1e-8 ? INFINITY : log(b / c) / log(2.0));
+              later_pair++;
+            }
             min_t_order[ex][s - 2] = fmin(min_t_order[ex][s - 2], q);
             t_order_checked++;
             FESD_TEST_CHECK(q >= want_q, "B: %s system %d, s=%d: %s time error %.2e (T/32) -> %.2e (T/64): order %.2f < %g",
@@ -247,9 +269,10 @@ static int part_b(int mode) {
   }
   printf("B (affine): %d systems (%d draws), %d runs, %.1f switches per long step on average; %d failed, %d with other "
          "events (and %d flagged too coarse); long-step error / order bound at most %.2f; order T/32 -> T/64 on %d pairs (min %.2f for s=2, %.2f "
-         "for s=3), %d pairs below 1e-8; event time order on %d pairs (min %.2f / %.2f, exits %.2f / %.2f)\n",
+         "for s=3; %d read on T/64 -> T/128), %d pairs below 1e-8; event time order on %d pairs (min %.2f / %.2f, exits "
+         "%.2f / %.2f)\n",
          n_sys, draws, runs, (double)ev_in_steps / (n_steps ? n_steps : 1), failed, wrong_events, coarse_flagged, worst_ratio,
-         order_checked, min_order[0], min_order[1], order_floor, t_order_checked, min_t_order[0][0], min_t_order[0][1],
+         order_checked, min_order[0], min_order[1], later_pair, order_floor, t_order_checked, min_t_order[0][0], min_t_order[0][1],
          min_t_order[1][0], min_t_order[1][1]);
   return fails;
 }
