@@ -166,6 +166,21 @@ class Bridge:
             vec = self.subs[sys].fields is not None  # one call for all modes: no mode to name
             return self._fail("fields" if vec else "field", sys, None if vec else mode, t, x, e)
 
+    def _jac(self, res, role, lead, transpose, sys, mode, t, x):
+        """A Jacobian callback's result as C-order buffers (d/dx of shape lead + (nx,), d/du of
+        lead + (nu,)), checked finite."""
+        dx, du = _pair(res, role, self.nu)
+        bx = _out(dx, lead + (self.nx,), role, transpose)
+        bu = _out(du, lead + (self.nu,), role + " (d/du)", transpose) if self.nu else b""
+        if not (_finite(bx) and _finite(bu)):
+            self._nonfinite(role, sys, mode, t, x)
+        return bx, bu
+
+    def _put_jac(self, dx_ptr, du_ptr, bx, bu):
+        _memmove(dx_ptr, bx, len(bx))
+        if du_ptr and self.nu:
+            _memmove(du_ptr, bu, len(bu))
+
     def _field_jac(self, sys, mode, t, x, u, dfdx, dfdu, user):
         try:
             sub, nx, nu = self.subs[sys], self.nx, self.nu
@@ -175,25 +190,13 @@ class Bridge:
                 cache = self.jcache[sys]
                 hit = cache.get(key)
                 if hit is None:
-                    dx, du = _pair(sub.fields_jac(*self._args(key)), "fields_jac", nu)
-                    bx = _out(dx, (sub.n_modes, nx, nx), "fields_jac", (0, 2, 1))
-                    bu = _out(du, (sub.n_modes, nx, nu), "fields_jac (d/du)", (0, 2, 1)) if nu else b""
-                    if not (_finite(bx) and _finite(bu)):
-                        self._nonfinite("fields_jac", sys, None, t, x)
-                    hit = (bx, bu)
+                    hit = self._jac(sub.fields_jac(*self._args(key)), "fields_jac", (sub.n_modes, nx), (0, 2, 1),
+                                    sys, None, t, x)
                     cache.put(key, hit)
-                _memmove(dfdx, hit[0][mode * nbx:(mode + 1) * nbx], nbx)
-                if dfdu and nu:
-                    _memmove(dfdu, hit[1][mode * nbu:(mode + 1) * nbu], nbu)
+                self._put_jac(dfdx, dfdu, hit[0][mode * nbx:(mode + 1) * nbx], hit[1][mode * nbu:(mode + 1) * nbu])
             else:
-                dx, du = _pair(sub.field_jac(mode, *self._args(self._key(t, x, u))), "field_jac", nu)
-                bx = _out(dx, (nx, nx), "field_jac", (1, 0))
-                bu = _out(du, (nx, nu), "field_jac (d/du)", (1, 0)) if nu else b""
-                if not (_finite(bx) and _finite(bu)):
-                    self._nonfinite("field_jac", sys, mode, t, x)
-                _memmove(dfdx, bx, nbx)
-                if dfdu and nu:
-                    _memmove(dfdu, bu, nbu)
+                res = sub.field_jac(mode, *self._args(self._key(t, x, u)))
+                self._put_jac(dfdx, dfdu, *self._jac(res, "field_jac", (nx,), (1, 0), sys, mode, t, x))
             return 0
         except BaseException as e:  # noqa: B902
             vec = self.subs[sys].fields_jac is not None
@@ -219,16 +222,9 @@ class Bridge:
 
     def _switch_jac(self, sys, t, x, u, dcdx, dcdu, user):
         try:
-            sub, nx, nu = self.subs[sys], self.nx, self.nu
-            rows = sub.n_rows
-            dx, du = _pair(sub.switch_jac(*self._args(self._key(t, x, u))), "switch_jac", nu)
-            bx = _out(dx, (rows, nx), "switch_jac", (1, 0))
-            bu = _out(du, (rows, nu), "switch_jac (d/du)", (1, 0)) if nu else b""
-            if not (_finite(bx) and _finite(bu)):
-                self._nonfinite("switch_jac", sys, None, t, x)
-            _memmove(dcdx, bx, len(bx))
-            if dcdu and nu:
-                _memmove(dcdu, bu, len(bu))
+            sub = self.subs[sys]
+            res = sub.switch_jac(*self._args(self._key(t, x, u)))
+            self._put_jac(dcdx, dcdu, *self._jac(res, "switch_jac", (sub.n_rows,), (1, 0), sys, None, t, x))
             return 0
         except BaseException as e:  # noqa: B902
             return self._fail("switch_jac", sys, None, t, x, e)
@@ -246,15 +242,8 @@ class Bridge:
 
     def _drift_jac(self, t, x, u, dfdx, dfdu, user):
         try:
-            nx, nu = self.nx, self.nu
-            dx, du = _pair(self.model.drift_jac(*self._args(self._key(t, x, u))), "drift_jac", nu)
-            bx = _out(dx, (nx, nx), "drift_jac", (1, 0))
-            bu = _out(du, (nx, nu), "drift_jac (d/du)", (1, 0)) if nu else b""
-            if not (_finite(bx) and _finite(bu)):
-                self._nonfinite("drift_jac", None, None, t, x)
-            _memmove(dfdx, bx, len(bx))
-            if dfdu and nu:
-                _memmove(dfdu, bu, len(bu))
+            res = self.model.drift_jac(*self._args(self._key(t, x, u)))
+            self._put_jac(dfdx, dfdu, *self._jac(res, "drift_jac", (self.nx,), (1, 0), None, None, t, x))
             return 0
         except BaseException as e:  # noqa: B902
             return self._fail("drift_jac", None, None, t, x, e)
