@@ -97,6 +97,14 @@ static void clock_system(pwa_sys *S) {
   for (int i = 0; i < 2; i++) S->d[0][i][0] = i == 0 ? -1 : 1, S->d[0][i][1] = 1, S->A[0][i][0][1] = 2;
 }
 
+/* the settings of both clock-system cases: Lobatto IIIC s = 2 */
+static void lobatto2(fesd_settings *set, int sens) {
+  fesd_settings_default(set);
+  set->family = FESD_RK_LOBATTO_IIIC;
+  set->stages = 2;
+  set->sensitivities = sens;
+}
+
 /* Lobatto IIIC s = 2, one step T = 1: FESD_OK on a solution without switches (x1(T) = 0.2), and
  * dx(T)/dx0 is not the derivative of that map (compared on the columns where the differences
  * with eps 1e-5, 1e-6, 1e-7 agree: near x2(0) = 0 the map jumps to the solution with the
@@ -109,10 +117,7 @@ static int lobatto_exit(void) {
   pr_model_init(&pm, &S, 1);
   const double x0[2] = {0.2, 0};
   fesd_settings set;
-  fesd_settings_default(&set);
-  set.family = FESD_RK_LOBATTO_IIIC;
-  set.stages = 2;
-  set.sensitivities = 1;
+  lobatto2(&set, 1);
   static pr_run r, rp, rm;
   const int st = pr_integrate(&pm.m, &set, x0, NULL, 1.0, 1, &r);
   double worst = 0;
@@ -151,10 +156,7 @@ static int sens_changes_state(void) {
   int st[2];
   for (int sens = 0; sens <= 1; sens++) {
     fesd_settings set;
-    fesd_settings_default(&set);
-    set.family = FESD_RK_LOBATTO_IIIC;
-    set.stages = 2;
-    set.sensitivities = sens;
+    lobatto2(&set, sens);
     st[sens] = pr_integrate(&pm.m, &set, x0, NULL, 1.0, 1, &r[sens]);
     printf("sensitivities = %d: %s, x(T) = (%.15f, %.15f), %d events\n", sens, fesd_status_name(st[sens]), r[sens].x[0],
            r[sens].x[1], r[sens].n_ev);
