@@ -44,6 +44,7 @@ typedef struct {
   double x[PWA_MAX_NX];
   double Sx[PWA_MAX_NX * PWA_MAX_NX], Su[PWA_MAX_NX * PWA_MAX_NU]; /* column-major */
   int splits, substeps, newton_iter;
+  double hmax; /* longest element of the accepted steps */
 } pr_run;
 
 /* Appends the events of the integrator's last step to r (up to PR_MAX_EV). */
@@ -74,6 +75,9 @@ static inline int pr_run_on(fesd_integrator *it, const fesd_model *m, int sens, 
     }
     r->flags |= info.flags;
     r->splits += info.splits, r->substeps += info.substeps, r->newton_iter += info.newton_iter;
+    fesd_step_data d;
+    fesd_last_step_data(it, &d);
+    for (int e = 0; e < d.n_elements; e++) r->hmax = fmax(r->hmax, d.h[e]);
     pr_record_events(it, r);
   }
   fesd_get_state(it, NULL, r->x);

@@ -99,30 +99,8 @@ static int part_a(int mode) {
 
 /* nsim steps of T_END/nsim; returns the longest element and fills r */
 static double run_hmax(const fesd_model *m, const fesd_settings *set, const double *x0, int nsim, pr_run *r) {
-  memset(r, 0, sizeof(*r));
-  r->fail_step = -1;
-  fesd_integrator *it;
-  double hmax = 0;
-  int st = fesd_create(&it, m, set);
-  if (st) return r->status = st, 0;
-  st = fesd_set_state(it, 0, x0, NULL);
-  for (int k = 0; k < nsim && !st; k++) {
-    fesd_step_info info;
-    st = fesd_step(it, NULL, T_END / nsim, &info);
-    if (st) {
-      r->fail_step = k;
-      break;
-    }
-    r->flags |= info.flags;
-    fesd_step_data d;
-    fesd_last_step_data(it, &d);
-    for (int e = 0; e < d.n_elements; e++) hmax = fmax(hmax, d.h[e]);
-    pr_record_events(it, r);
-  }
-  fesd_get_state(it, NULL, r->x);
-  fesd_free(&it);
-  r->status = st;
-  return hmax;
+  pr_integrate(m, set, x0, NULL, T_END, nsim, r);
+  return r->hmax;
 }
 
 /* largest event time error of the sliding exits (exit = 1) or of the other events (exit = 0);
