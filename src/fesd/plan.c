@@ -323,6 +323,16 @@ static int coupled(fesd_integrator *it, const double *z, double t, int k, int i,
   return FESD_OK;
 }
 
+/* A switch that a correction left without a change is removed: its boundary row holds for any
+ * boundary time, so the solve could settle anywhere in a family of solutions (fuzzing, Gauss
+ * s = 1: another subsystem's crossing moved by 1e-4, or dx(T)/dx0 off by 11, with FESD_OK) or
+ * let an element step over the region. */
+static void remove_if_unchanged(fesd_integrator *it, int e) {
+  const fesd__model *m = &it->model;
+  const int a = m->th_off[it->plan[e].sys], b = m->th_off[it->plan[e].sys + 1];
+  if (!memcmp(after(it, e) + a, set_before_switch(it, e) + a, (size_t)(b - a))) remove_switch(it, e);
+}
+
 static int update_one(fesd_integrator *it, const double *z, const fesd__violation *v, double T) {
   const fesd__model *m = &it->model;
   const int k = v->sys, a = m->th_off[k], b = m->th_off[k + 1];
@@ -343,17 +353,13 @@ static int update_one(fesd_integrator *it, const double *z, const fesd__violatio
     memcpy(after(it, e) + a, ns + a, (size_t)(b - a));
     it->plan[e].fresh = 1;
     drop_after(it, k, it->plan[e].t);
-    /* a switch left without a change is removed: its boundary row holds for any boundary
-     * time, so the solve can settle anywhere in a family of solutions (fuzzing, Gauss s = 1:
-     * the other subsystem's crossing moved by 1e-4 and dx(T)/dx0 off by 11, with FESD_OK) */
-    if (!memcmp(after(it, e) + a, set_before_switch(it, e) + a, (size_t)(b - a))) remove_switch(it, e);
+    remove_if_unchanged(it, e);
     return 1;
   }
   if (v->first && e >= 0) {
     /* the switch before chose the wrong modes: add the mode that wants in, drop the one
      * that wants out; a mode that this switch brought in alone (a crossing) and that wants
-     * out again makes it a sliding mode with the modes before; a switch left without a
-     * change is removed (its boundary would only let an element step over the region) */
+     * out again makes it a sliding mode with the modes before */
     fesd__switch *w = &it->plan[e];
     unsigned char *A = after(it, e);
     if (++w->tries > MAX_TRIES || A[v->mode] == (unsigned char)v->enter) return 0;
@@ -368,7 +374,7 @@ static int update_one(fesd_integrator *it, const double *z, const fesd__violatio
     w->fresh = 1;
     if (empty_set(it, A, k)) return 0;
     drop_after(it, k, w->t);
-    if (!memcmp(A + a, B + a, (size_t)(b - a))) remove_switch(it, e);
+    remove_if_unchanged(it, e);
     return 1;
   }
   /* a new switch at the predicted time */
