@@ -1,6 +1,6 @@
 /* Minimal reproducers of the library failures found by the property tests (tests/prop), one case
- * per argument; each is registered with should_fail: true until the library is fixed (see
- * tests/prop/meson.build). References: pwa_ref.c and closed forms.
+ * per argument, kept as regression tests (all fixed). References: pwa_ref.c, closed forms and
+ * differences of the map.
  *  codim2-entry:   entering sliding on the intersection of two surfaces fails (STEP_FAILED)
  *  cross-sliding:  crossing one surface while sliding on another fails (STEP_FAILED)
  *  missed-exit:    a long step with a sliding entry, exit and crossing: FESD_OK without the exit,
@@ -15,7 +15,9 @@
  *                  the derivative of the map (4e4 off with finite-difference Jacobians), no flag
  *  gauss-codim2:   Gauss-Legendre entering sliding on an intersection (piecewise-constant fields,
  *                  which FESD integrates exactly): x(T) off by 1.5e-3, flagged SENS_INACCURATE
- *                  only (which says the state is to be trusted) */
+ *                  only (which says the state is to be trusted)
+ *  cut-sens:       an entry and an exit in one step that is cut into sub-steps: dx(T)/d(x0, u)
+ *                  5e-5 off the derivative of the map, no flag */
 #include <stdlib.h>
 
 #include "prop_util.h"
@@ -272,6 +274,74 @@ static int radau_exit(void) {
   return fails;
 }
 
+/* found by prop_sens (another seed, problem 68): affine fields in R^3 with two controls, one
+ * subsystem that slides from 1.1495 to 1.2913 (reference); Radau IIA s = 2, N_FE = 3, N_sim = 3:
+ * the second step holds the entry and the exit and is cut into two sub-steps. The cut was the
+ * midpoint between predicted switch times, which move with x0 and u: the map depended on them
+ * through the sub-step lengths, a term the sub-steps' sensitivities do not have, and dx(T)/dx0
+ * and dx(T)/du were 5e-5 off the map's differences (these converge: eps 1e-4 .. 1e-7 agree to
+ * 1e-9). Asserted: FESD_OK, a cut step, and every column within 1e-7 of the differences. */
+static int cut_sens(void) {
+  int fails = 0;
+  pwa_sys S;
+  memset(&S, 0, sizeof(S));
+  S.nx = 3, S.K = 1, S.nu = 2, S.affine = 1;
+  const double a[3] = {0.2057006650664929, 0.97861495818897148, -0.11596787096434963};
+  const double d[2][3] = {{-2.0404559595021907, -1.59325095811201, 0.41993032576765882},
+                          {2.3437076197289812, 2.2998035591726258, 0.28733851376846525}};
+  const double A[2][9] = {{0.03524298871697451, 2.704149822273171, 0.24317619423631087, -2.9484261081560028,
+                           0.4816737160338026, -0.33850738238998052, -0.54873938440097814, 0.21548478388594838,
+                           -0.38738057289823846},
+                          {-0.14911177692527267, 3.2507388846933187, -0.55401406771642148, -2.3946443614088873,
+                           -0.082520571956031796, -0.1638955662050261, 0.069636298125484886, 0.17064244214055313,
+                           -0.54564176643299256}};
+  const double B[2][6] = {{-0.21748681297943051, -0.34106859960502356, -0.15910247373042896, 0.11170108426385716,
+                           -0.17202249123730673, -0.25724935397279869},
+                          {0.16023983061863234, 0.0011490713858811619, 0.38521475984866116, 0.17202339672099387,
+                           -0.39258529531069219, 0.22336460728677943}};
+  S.b[0] = -0.033533569096981741;
+  for (int q = 0; q < 3; q++) {
+    S.a[0][q] = a[q];
+    for (int i = 0; i < 2; i++) {
+      S.d[0][i][q] = d[i][q];
+      for (int c = 0; c < 3; c++) S.A[0][i][q][c] = A[i][q * 3 + c];
+      for (int c = 0; c < 2; c++) S.B[0][i][q][c] = B[i][q * 2 + c];
+    }
+  }
+  const double x0[3] = {1.1022933935617556, -1.2605731607206052, 0.0621214951286998};
+  const double u[2] = {-0.053952135844676841, -0.089303932698202304};
+  pr_model pm;
+  pr_model_init(&pm, &S, 1);
+  fesd_settings set;
+  fesd_settings_default(&set);
+  set.n_fe = 3;
+  set.sensitivities = 1;
+  static pr_run r, rp, rm;
+  const int st = pr_integrate(&pm.m, &set, x0, u, 2.0, 3, &r);
+  double worst = 0;
+  for (int j = 0; j < 5; j++) { /* x0 then u */
+    const double eps = 1e-6;
+    double xp[3], xm[3], up[2], um[2];
+    memcpy(xp, x0, sizeof(xp)), memcpy(xm, x0, sizeof(xm)), memcpy(up, u, sizeof(up)), memcpy(um, u, sizeof(um));
+    if (j < 3) xp[j] += eps, xm[j] -= eps;
+    else up[j - 3] += eps, um[j - 3] -= eps;
+    const int a1 = pr_integrate(&pm.m, &set, xp, up, 2.0, 3, &rp), a2 = pr_integrate(&pm.m, &set, xm, um, 2.0, 3, &rm);
+    double dev = a1 || a2 ? INFINITY : 0, big = 1;
+    for (int i = 0; i < 3; i++) {
+      const double Sij = j < 3 ? r.Sx[j * 3 + i] : r.Su[(j - 3) * 3 + i];
+      dev = fmax(dev, fabs(Sij - (rp.x[i] - rm.x[i]) / (2 * eps)));
+      big = fmax(big, fabs(Sij));
+    }
+    worst = fmax(worst, dev / big);
+  }
+  printf("Radau IIA s=2 N_FE=3 N_sim=3: %s, %d events, %d sub-steps, flags 0x%x, sensitivities vs differences %.2e\n",
+         fesd_status_name(st), r.n_ev, r.substeps, r.flags, worst);
+  FESD_TEST_CHECK(st == FESD_OK && r.substeps > 0 && worst <= 1e-7,
+                  "%s, %d sub-steps (the case needs a cut step), dx(T)/d(x0, u) vs differences %.2e (relative)",
+                  fesd_status_name(st), r.substeps, worst);
+  return fails;
+}
+
 /* found by prop_sens: piecewise-constant fields, slides on c_0 from 0.29 and on both from 0.72 */
 static int gauss_codim2(void) {
   pwa_sys S;
@@ -349,9 +419,11 @@ int main(int argc, char **argv) {
     fails = radau_exit();
   } else if (!strcmp(c, "gauss-codim2")) {
     fails = gauss_codim2();
+  } else if (!strcmp(c, "cut-sens")) {
+    fails = cut_sens();
   } else {
     printf("usage: %s codim2-entry|cross-sliding|missed-exit|grid-sens|lobatto-exit|sens-changes-state|"
-           "radau-exit-sens|gauss-codim2\n",
+           "radau-exit-sens|gauss-codim2|cut-sens\n",
            argv[0]);
     return 2;
   }
