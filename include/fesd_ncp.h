@@ -109,6 +109,13 @@ typedef struct {
   double sigma_min;      /**< last positive sigma before the final sigma = 0 stage, [1e-16, sigma0] (default 1e-8) */
   double homotopy_tol_factor; /**< intermediate stages stop at ||F|| <= factor*sigma, (0, 1] (default 1e-2) */
   double lm_mu0;         /**< initial LM damping factor: mu = lambda ||F||_2, lambda adapted by the gain ratio, [1e-10, 1e10] (default 1e-3) */
+  int slow_iter;         /**< progress check: a stage whose ||F||_inf after slow_iter iterations is above
+                              slow_ratio times its value after the first iteration ends with
+                              FESD_ERR_LINE_SEARCH (no sufficient decrease); 0 = off (default), else
+                              [2, 1000]. The first step is left out: from a poor guess it often gains
+                              a lot and then creeps. For callers that have a cheaper alternative than
+                              iterating on (a guess out of Newton's reach) */
+  double slow_ratio;     /**< see slow_iter, (0, 1] (default 0.5) */
   fesd_ncp_log_fn log;   /**< optional iteration log (default NULL = silent) */
   void *log_user;
 } fesd_ncp_settings;

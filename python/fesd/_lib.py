@@ -27,7 +27,8 @@ class NcpSettings(ctypes.Structure):
     _fields_ = [("tol", c_double), ("max_iter", c_int), ("backend", c_int), ("dense_max_n", c_int),
                 ("armijo", c_double), ("backtrack", c_double), ("max_backtracks", c_int),
                 ("sigma0", c_double), ("sigma_factor", c_double), ("sigma_min", c_double),
-                ("homotopy_tol_factor", c_double), ("lm_mu0", c_double), ("log", c_void_p),
+                ("homotopy_tol_factor", c_double), ("lm_mu0", c_double),
+                ("slow_iter", c_int), ("slow_ratio", c_double), ("log", c_void_p),
                 ("log_user", c_void_p)]
 
 

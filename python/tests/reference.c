@@ -22,7 +22,7 @@
 static int layout(void) {
   printf("size fesd_ncp_settings %zu\n", sizeof(fesd_ncp_settings));
   OFF(fesd_ncp_settings, max_iter); OFF(fesd_ncp_settings, armijo); OFF(fesd_ncp_settings, max_backtracks);
-  OFF(fesd_ncp_settings, sigma0); OFF(fesd_ncp_settings, lm_mu0); OFF(fesd_ncp_settings, log_user);
+  OFF(fesd_ncp_settings, sigma0); OFF(fesd_ncp_settings, lm_mu0); OFF(fesd_ncp_settings, slow_ratio); OFF(fesd_ncp_settings, log_user);
   printf("size fesd_settings %zu\n", sizeof(fesd_settings));
   OFF(fesd_settings, n_fe); OFF(fesd_settings, newton_tol); OFF(fesd_settings, cc_tol); OFF(fesd_settings, exit_rows);
   OFF(fesd_settings, coarse_tol); OFF(fesd_settings, max_elements); OFF(fesd_settings, ncp);

@@ -226,11 +226,17 @@ static int stage(fesd_ncp *ws, double *z, double sigma, double tol, fesd__ncp_st
   ss.nrm = norm_inf(ws->F_c, ws->m);
   ss.f2 = dot(ws->F_c, ws->F_c, ws->m);
 
+  double nrm1 = INFINITY; /* after the first iteration (the progress check) */
   for (int it = 0;; it++) {
     history_push(info, ss.nrm);
     *res = ss.nrm;
     if (ss.nrm <= tol) {
       status = FESD_OK;
+      break;
+    }
+    if (it == 1) nrm1 = ss.nrm;
+    if (it > 1 && it == s->slow_iter && ss.nrm > s->slow_ratio * nrm1) {
+      status = FESD_ERR_LINE_SEARCH; /* the caller's progress check (settings.slow_iter) */
       break;
     }
     if (stall >= (lm ? LM_STALL_COUNT : STALL_COUNT)) {

@@ -23,6 +23,7 @@ int fesd_ncp_settings_default(fesd_ncp_settings *s) {
   s->sigma_min = 1e-8;
   s->homotopy_tol_factor = 1e-2;
   s->lm_mu0 = 1e-3;
+  s->slow_ratio = 0.5;
   return FESD_OK;
 }
 
@@ -41,7 +42,8 @@ static int validate_settings(const fesd_ncp_settings *s) {
       !(s->sigma0 > 0.0 && s->sigma0 <= 1e3) || !(s->sigma_factor > 0.0 && s->sigma_factor <= 0.9) ||
       !in_range(s->sigma_min, 1e-16, s->sigma0) ||
       !(s->homotopy_tol_factor > 0.0 && s->homotopy_tol_factor <= 1.0) ||
-      !in_range(s->lm_mu0, 1e-10, 1e10))
+      !in_range(s->lm_mu0, 1e-10, 1e10) || !(s->slow_iter == 0 || int_in(s->slow_iter, 2, 1000)) ||
+      !(s->slow_ratio > 0.0 && s->slow_ratio <= 1.0))
     return FESD_ERR_INVALID_ARG;
   return FESD_OK;
 }

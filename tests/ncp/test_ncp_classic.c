@@ -337,6 +337,27 @@ int main(void) {
     printf("  plain Newton from 0: %s after %d iterations, z = %.4f, |F| = %.2e\n",
            fesd_status_name(rc), info.iterations, z[0], info.residual);
     CHECK(rc != FESD_OK, "billups from 0 was expected to stall without the homotopy");
+    /* the progress check (settings.slow_iter): the same stall ends after 3 iterations, with
+     * the residual history showing why; from 3 Newton converges and the check stays silent */
+    const double F1 = info.residual_history[1], F3 = info.residual_history[3];
+    fesd_ncp_settings s;
+    fesd_ncp_settings_default(&s);
+    s.backend = FESD_NCP_BACKEND_DENSE;
+    s.slow_iter = 3;
+    s.slow_ratio = 0.5;
+    CHECK(fesd_ncp_update_settings(ws, &s) == FESD_OK, "update settings");
+    z[0] = 0.0;
+    rc = fesd_ncp_solve(ws, z, 0.0, &info);
+    printf("  with slow_iter = 3: %s after %d iterations (|F| after 1: %.3e, after 3: %.3e)\n",
+           fesd_status_name(rc), info.iterations, F1, info.residual);
+    CHECK(F3 > 0.5 * F1, "billups from 0: |F| after 3 iterations %.3e vs %.3e: no stall to detect", F3, F1);
+    CHECK(rc == FESD_ERR_LINE_SEARCH && info.iterations == 3 && info.residual == F3,
+          "slow_iter = 3: %s after %d iterations, |F| %.3e (expected LINE_SEARCH after 3, |F| %.3e)",
+          fesd_status_name(rc), info.iterations, info.residual, F3);
+    z[0] = 3.0;
+    rc = fesd_ncp_solve(ws, z, 0.0, &info);
+    CHECK(rc == FESD_OK && fabs(z[0] - zs[0]) <= 1e-10, "slow_iter = 3 from 3: %s, z = %.12f",
+          fesd_status_name(rc), z[0]);
     fesd_ncp_free(&ws);
     run(&bi, z0, zs, HOMOTOPY, NULL);
   }

@@ -12,7 +12,7 @@ static void settings_errors(const fesd_ncp_problem *p) {
   CHECK(d.tol == 1e-12 && d.max_iter == 50 && d.backend == FESD_NCP_BACKEND_AUTO &&
             d.dense_max_n == FESD_NCP_DENSE_MAX_N && d.armijo == 1e-4 && d.backtrack == 0.5 &&
             d.max_backtracks == 30 && d.sigma0 == 1e-1 && d.sigma_factor == 0.1 &&
-            d.sigma_min == 1e-8 && d.homotopy_tol_factor == 1e-2 && d.lm_mu0 == 1e-3 && !d.log,
+            d.sigma_min == 1e-8 && d.homotopy_tol_factor == 1e-2 && d.lm_mu0 == 1e-3 && d.slow_iter == 0 && d.slow_ratio == 0.5 && !d.log,
         "documented defaults");
   static const char *const bad[] = {
       "tol = 0",        "tol = -1",         "tol = NaN",          "tol = Inf",
@@ -24,7 +24,8 @@ static void settings_errors(const fesd_ncp_problem *p) {
       "dense_max_n = 5001", "armijo = NaN", "backtrack = NaN",    "max_backtracks = 101",
       "sigma0 = 1e4",   "sigma0 = NaN",     "sigma_factor = 0.95", "sigma_factor = NaN",
       "sigma_min = 1e-17", "sigma_min = NaN", "homotopy_tol_factor = 2", "homotopy_tol_factor = NaN",
-      "lm_mu0 = 1e11",  "lm_mu0 = 1e-11",   "lm_mu0 = NaN"};
+      "lm_mu0 = 1e11",  "lm_mu0 = 1e-11",   "slow_iter = 1",      "slow_iter = 1001",
+      "slow_ratio = 0", "slow_ratio = 1.5", "slow_ratio = NaN",   "lm_mu0 = NaN"};
   const size_t nbad = sizeof bad / sizeof bad[0];
   for (size_t k = 0; k < nbad; k++) {
     fesd_ncp_settings s = d;
@@ -67,6 +68,11 @@ static void settings_errors(const fesd_ncp_problem *p) {
     case 35: s.homotopy_tol_factor = NAN; break;
     case 36: s.lm_mu0 = 1e11; break;
     case 37: s.lm_mu0 = 1e-11; break;
+    case 38: s.slow_iter = 1; break;
+    case 39: s.slow_iter = 1001; break;
+    case 40: s.slow_ratio = 0; break;
+    case 41: s.slow_ratio = 1.5; break;
+    case 42: s.slow_ratio = NAN; break;
     default: s.lm_mu0 = NAN; break;
     }
     fesd_ncp *ws = (fesd_ncp *)&s; /* must be reset to NULL on error */
