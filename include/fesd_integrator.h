@@ -170,9 +170,10 @@ typedef struct {
                                  sub-steps for costlier solves (measured on a friction chain with
                                  many switches per step: 8 fastest of 4 .. 32) */
   fesd_ncp_settings ncp;    /**< linear algebra/line-search settings of the solver, ranges as
-                                 in fesd_ncp.h; ncp.tol and ncp.max_iter are ignored (the
-                                 integrator sets them from newton_tol, max_iter_first,
-                                 max_iter) */
+                                 in fesd_ncp.h; ncp.tol, ncp.max_iter, ncp.slow_iter and
+                                 ncp.slow_ratio are ignored (the integrator sets them from
+                                 newton_tol, max_iter_first, max_iter, and its own progress
+                                 check of plan solves) */
 } fesd_settings;
 
 typedef enum {

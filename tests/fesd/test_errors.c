@@ -116,6 +116,8 @@ static const bad_case setting_cases[] = {
     {"ncp.sigma_factor = 0.95", FESD_ERR_INVALID_ARG}, {"ncp.sigma_min = 1e-17", FESD_ERR_INVALID_ARG},
     {"ncp.homotopy_tol_factor = 2", FESD_ERR_INVALID_ARG}, {"ncp.lm_mu0 = 1e11", FESD_ERR_INVALID_ARG},
     {"ncp.lm_mu0 = NaN", FESD_ERR_INVALID_ARG},
+    {"ncp.slow_iter = 1", FESD_ERR_INVALID_ARG}, {"ncp.slow_ratio = NaN", FESD_ERR_INVALID_ARG},
+    {"ncp.slow_iter = 3 (ignored: set per solve)", FESD_OK},
     {"ncp.tol = -1 (ignored: newton_tol)", FESD_OK}, {"ncp.max_iter = 0 (ignored: max_iter)", FESD_OK}};
 
 static void break_setting(int k, fesd_settings *s) {
@@ -167,7 +169,10 @@ static void break_setting(int k, fesd_settings *s) {
   case 44: s->ncp.homotopy_tol_factor = 2; break;
   case 45: s->ncp.lm_mu0 = 1e11; break;
   case 46: s->ncp.lm_mu0 = NAN; break;
-  case 47: s->ncp.tol = -1; break;
+  case 47: s->ncp.slow_iter = 1; break;
+  case 48: s->ncp.slow_ratio = NAN; break;
+  case 49: s->ncp.slow_iter = 3; break;
+  case 50: s->ncp.tol = -1; break;
   default: s->ncp.max_iter = 0; break;
   }
 }
