@@ -193,7 +193,7 @@ if (system("test -f ".f." && echo 1") eq "1") {
   set key bottom left font ",8"
   ofams = "radau lobatto3c gauss erk"
   ofamname = "Radau-IIA Lobatto-IIIC Gauss-Legendre explicit"
-  set title "ocp\\_step\\_eq (N_{ctrl} = 6), converged solves: FESD (filled; grey: without the presolve), standard (open circles; triangles: without the presolve); marker size grows with s" font ",9"
+  set title "ocp\\_step\\_eq (N_{ctrl} = 6), converged: FESD filled (grey: presolve = 0), standard open (triangles: presolve = 0); size grows with s" font ",9"
   pre(p) = column("presolve") == p
   plot f using (sel("method","fesd") && pre(0) && sel("status","FESD_OK") ? column("cpu_ms") : NaN):(column("E")):(0.4+0.25*column("s")) \
          with points lc rgb "#b0b0b0" pt 7 ps variable title "FESD, presolve = 0", \
