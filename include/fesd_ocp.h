@@ -155,6 +155,15 @@ typedef struct {
   fesd_ncp_backend qp_backend; /**< linear solver of the QP (default AUTO: dense up to
                                   FESD_NCP_DENSE_MAX_N unknowns, else KLU) */
   fesd_ocp_init init;        /**< guess when fesd_ocp_set_guess was not called (default SIMULATE) */
+  int presolve;              /**< 1: a solve that starts from a new guess (fesd_ocp_set_guess or
+                                  settings.init) first solves the same OCP with the standard
+                                  method, Radau IIA s = 1 (implicit Euler) with presolve_n_fe
+                                  elements per interval, and starts from its solution and
+                                  multipliers; when that solve fails or its point cannot be
+                                  evaluated, from the guess. Skipped when the discretisation is
+                                  the standard method with stages * n_fe <= presolve_n_fe (no
+                                  finer than the presolve's). 0 or 1 (default 1) */
+  int presolve_n_fe;         /**< elements per interval of the presolve, [1, 100] (default 2) */
   int verbose;               /**< 1: one log line per iteration (default 0) */
   fesd_ocp_log_fn log;       /**< sink of the log (NULL: stdout) */
   void *log_user;
@@ -190,6 +199,11 @@ typedef struct {
   double time_other;        /**< the rest (functions, Hessian, line search bookkeeping) */
   int hessian_fallback;     /**< 1: GN_SR1 fell back to Gauss-Newton (settings.stall_window) */
   int stalled;              /**< 1: ended by the no-progress rule (status FESD_ERR_LINE_SEARCH) */
+  int presolve_run;         /**< 1: this solve ran a presolve (settings.presolve) */
+  int presolve_status;      /**< ... and its status (FESD_OK when none was run) */
+  int presolve_iterations;  /**< its SQP iterations (its integrations and CPU times are included
+                                 in the fields above) */
+  int presolve_used;        /**< 1: the SQP started from the presolve's solution */
 } fesd_ocp_info;
 
 /** Multipliers of the returned iterate, in the user's layout (pointers into the workspace,

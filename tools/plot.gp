@@ -193,9 +193,14 @@ if (system("test -f ".f." && echo 1") eq "1") {
   set key bottom left font ",8"
   ofams = "radau lobatto3c gauss erk"
   ofamname = "Radau-IIA Lobatto-IIIC Gauss-Legendre explicit"
-  set title "ocp\\_step\\_eq (N_{ctrl} = 6): FESD (filled) vs standard (open), marker size grows with s; converged solves (ocp\\_pareto.csv)"
-  plot for [a=1:4] f using (sel("method","fesd") && sel("family", word(ofams,a)) && sel("status","FESD_OK") ? column("cpu_ms") : NaN):(column("E")):(0.4+0.25*column("s")) \
+  set title "ocp\\_step\\_eq (N_{ctrl} = 6), converged: FESD filled (grey: presolve = 0), standard open (triangles: presolve = 0); size grows with s" font ",9"
+  pre(p) = column("presolve") == p
+  plot f using (sel("method","fesd") && pre(0) && sel("status","FESD_OK") ? column("cpu_ms") : NaN):(column("E")):(0.4+0.25*column("s")) \
+         with points lc rgb "#b0b0b0" pt 7 ps variable title "FESD, presolve = 0", \
+       for [a=1:4] f using (sel("method","fesd") && pre(1) && sel("family", word(ofams,a)) && sel("status","FESD_OK") ? column("cpu_ms") : NaN):(column("E")):(0.4+0.25*column("s")) \
          with points lc rgb word(cols,a) pt 7 ps variable title "FESD ".word(ofamname,a), \
-       for [a=1:4] f using (sel("method","standard") && sel("family", word(ofams,a)) && sel("status","FESD_OK") ? column("cpu_ms") : NaN):(column("E")):(0.4+0.25*column("s")) \
-         with points lc rgb word(cols,a) pt 6 ps variable title "standard ".word(ofamname,a)
+       for [a=1:4] f using (sel("method","standard") && pre(1) && sel("family", word(ofams,a)) && sel("status","FESD_OK") ? column("cpu_ms") : NaN):(column("E")):(0.4+0.25*column("s")) \
+         with points lc rgb word(cols,a) pt 6 ps variable title "standard ".word(ofamname,a), \
+       for [a=1:4] f using (sel("method","standard") && pre(0) && sel("family", word(ofams,a)) && sel("status","FESD_OK") ? column("cpu_ms") : NaN):(column("E")):(0.4+0.25*column("s")) \
+         with points lc rgb word(cols,a) pt 8 ps variable notitle
 }

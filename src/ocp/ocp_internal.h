@@ -94,6 +94,8 @@ struct fesd_ocp {
   int have_guess;           /* wg is set (by fesd_ocp_set_guess or a previous solve) */
   int guess_pending;        /* wg's states are to be simulated by the solve's first evaluation */
   int warm;                 /* y_best holds multipliers of wg (a previous solve) */
+  int fresh_guess;          /* wg is a new guess (set_guess), not a previous solution */
+  struct fesd_ocp *pre;     /* the presolve's workspace (settings.presolve), or NULL */
   /* multipliers in the user's layout */
   double *m_dyn, *m_x0, *m_xb, *m_ub, *m_path, *m_term, *m_l1;
   fesd_ocp_info info;
@@ -139,6 +141,11 @@ void fesd__ocp_qp_free(ocp_qp *q);
  * (elastic); d, mult (mE + mI) out; *vlin: l1 violation of the linearisation at d. */
 int fesd__ocp_qp_solve(fesd_ocp *o, ocp_qp *q, const ocp_point *pt, const double *c, double nu, double *d,
                        double *mult, double *vlin);
+
+/* presolve.c: create the presolve's workspace when settings.presolve applies (s: the user's
+ * settings); run it from the guess wg: 1 when cur->w and y now hold its solution */
+int fesd__ocp_presolve_create(fesd_ocp *o, const fesd_ocp_settings *s);
+int fesd__ocp_presolve(fesd_ocp *o);
 
 /* sqp.c helpers used by access.c */
 void fesd__ocp_unpack_multipliers(fesd_ocp *o, const double *mult);

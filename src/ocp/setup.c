@@ -29,6 +29,8 @@ int fesd_ocp_settings_default(fesd_ocp_settings *s) {
   s->stall_window = 6;
   s->qp_backend = FESD_NCP_BACKEND_AUTO;
   s->init = FESD_OCP_INIT_SIMULATE;
+  s->presolve = 1;
+  s->presolve_n_fe = 2;
   return FESD_OK;
 }
 
@@ -45,7 +47,8 @@ static int check_settings(const fesd_ocp_settings *s) {
       s->stall_window < 0 || s->stall_window > 1000 || s->nonmonotone < 1 ||
       s->nonmonotone > FESD_OCP_MAX_NONMONOTONE ||
       (int)s->qp_backend < 0 || (int)s->qp_backend > FESD_NCP_BACKEND_CHOLMOD ||
-      !(s->init == FESD_OCP_INIT_SIMULATE || s->init == FESD_OCP_INIT_CONSTANT) || (s->verbose != 0 && s->verbose != 1))
+      !(s->init == FESD_OCP_INIT_SIMULATE || s->init == FESD_OCP_INIT_CONSTANT) || (s->verbose != 0 && s->verbose != 1) ||
+      (s->presolve != 0 && s->presolve != 1) || s->presolve_n_fe < 1 || s->presolve_n_fe > 100)
     return FESD_ERR_INVALID_ARG;
   return FESD_OK;
 }
@@ -116,6 +119,7 @@ void fesd_ocp_free(fesd_ocp **op) {
   if (!op || !*op) return;
   fesd_ocp *o = *op;
   fesd_free(&o->it);
+  fesd_ocp_free(&o->pre);
   fesd__ocp_qp_free(&o->qp);
   fesd__ocp_qp_free(&o->qe);
   for (int i = 0; i < 3; i++) point_free(&o->pt[i]);
@@ -243,6 +247,7 @@ int fesd_ocp_create(fesd_ocp **op, const fesd_ocp_problem *p, const fesd_ocp_set
   st = fesd_create(&o->it, &o->model, &o->set.integrator);
   if (!st) st = fesd__ocp_qp_setup(o, &o->qp, 0);
   if (!st) st = fesd__ocp_qp_setup(o, &o->qe, 1);
+  if (!st) st = fesd__ocp_presolve_create(o, s);
   if (st) {
     fesd_ocp_free(&o);
     return st;
@@ -285,6 +290,7 @@ int fesd_ocp_set_guess(fesd_ocp *o, const double *x, const double *u) {
   }
   memset(o->y_best, 0, (size_t)(o->mE + o->mI) * sizeof(double));
   o->have_guess = 1;
+  o->fresh_guess = 1;
   return FESD_OK;
 }
 

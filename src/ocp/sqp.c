@@ -224,7 +224,9 @@ static int stalled(const fesd_ocp *o, stall_track *t, double alpha) {
   return 1;
 }
 
-static int iterate(fesd_ocp *o) {
+/* warm: the start has multipliers (a previous solve or the presolve), so it may pass the KKT
+ * test at once */
+static int iterate(fesd_ocp *o, int warm) {
   const int m = o->mE + o->mI;
   double nu = o->set.penalty0;
   int elastic = 0, reset_done = 0, st;
@@ -238,7 +240,7 @@ static int iterate(fesd_ocp *o) {
     fesd_ocp_info r = {0};
     const double score = kkt(o, o->cur, o->y, &r);
     keep_best(o, score, &r);
-    if ((iter > 0 || o->warm) && score <= 1.0) return FESD_OK;
+    if ((iter > 0 || warm) && score <= 1.0) return FESD_OK;
     if (iter >= o->set.max_iter) return FESD_ERR_ITER_LIMIT;
     if (hess == FESD_OCP_HESSIAN_GAUSS_NEWTON) fesd__ocp_hessian_gn(o, o->cur);
     if (hess == FESD_OCP_HESSIAN_GN_SR1) fesd__ocp_hessian_gn_sr1(o, o->cur);
@@ -316,19 +318,32 @@ int fesd_ocp_solve(fesd_ocp *o, fesd_ocp_info *info) {
   memset(&o->info, 0, sizeof(o->info));
   o->t_int = o->t_qp = 0;
   int st = FESD_OK;
+  o->info.presolve_status = FESD_OK;
   if (!o->have_guess) st = fesd_ocp_set_guess(o, NULL, NULL);
-  memcpy(o->cur->w, o->wg, (size_t)o->nw * sizeof(double));
-  memcpy(o->y, o->y_best, (size_t)m * sizeof(double)); /* zero unless warm */
+  int pre = !st && fesd__ocp_presolve(o);
+  if (pre) {
+    say(o, "presolve (standard method, implicit Euler): %d iterations, %s", o->info.presolve_iterations,
+        fesd_status_name(o->info.presolve_status));
+    st = fesd__ocp_eval(o, o->cur);
+    pre = !st;
+    if (st && st != FESD_ERR_NOMEM) st = FESD_OK; /* its point cannot be evaluated: from the guess */
+  }
+  if (!pre) {
+    memcpy(o->cur->w, o->wg, (size_t)o->nw * sizeof(double));
+    memcpy(o->y, o->y_best, (size_t)m * sizeof(double)); /* zero unless warm */
+    if (!st) st = o->guess_pending ? fesd__ocp_eval_guess(o, o->cur) : fesd__ocp_eval(o, o->cur);
+    if (o->guess_pending) memcpy(o->wg, o->cur->w, (size_t)o->nw * sizeof(double)); /* the simulated guess */
+  }
+  o->info.presolve_used = pre;
+  o->guess_pending = 0;
+  o->fresh_guess = 0;
   o->best_score = INFINITY;
   memset(&o->best_info, 0, sizeof(o->best_info));
-  if (!st) st = o->guess_pending ? fesd__ocp_eval_guess(o, o->cur) : fesd__ocp_eval(o, o->cur);
-  if (o->guess_pending) memcpy(o->wg, o->cur->w, (size_t)o->nw * sizeof(double)); /* the simulated guess */
-  o->guess_pending = 0;
-  memcpy(o->w_best, o->wg, (size_t)o->nw * sizeof(double));
+  memcpy(o->w_best, o->cur->w, (size_t)o->nw * sizeof(double));
   if (!st) {
     fesd__ocp_hessian_reset(o);
     fesd__ocp_sr1_reset(o);
-    st = iterate(o);
+    st = iterate(o, o->warm || pre);
   }
   /* the returned iterate: the best one (the last one on success) */
   fesd_ocp_info *r = &o->info;

@@ -40,6 +40,7 @@ static int solve(const fesd_problem *P, fesd_rk_family fam, int s, fesd_ocp_hess
   set.integrator.stages = s;
   set.integrator.n_fe = 2;
   set.hessian = h;
+  set.presolve = 0; /* the rule from the cold guess (the presolve's start changes the path) */
   set.verbose = 1;
   set.log = sink;
   nlog = 0;
