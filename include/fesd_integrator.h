@@ -196,7 +196,7 @@ typedef struct {
   const int *after;      /**< ... and after; both valid until the next fesd_step / fesd_set_state */
 } fesd_event;
 
-/** Flags of a step (fesd_step_info.flags, counted in fesd_stats.flagged): the result was
+/** Flags of a step (fesd_step_info.flags, counted per flag in fesd_stats): the result was
  *  accepted, and this is what the user should know about it. */
 #define FESD_FLAG_NONUNIQUE 0x1 /**< the step started on a switching surface that the fields on
                                      both sides leave: the Filippov solution is not unique (the one

@@ -73,7 +73,7 @@ void fesd_free(fesd_integrator **itp) {
                     it->zpred, it->zp, it->raw,       it->lb,    it->ub,     it->Sx,    it->Su,
                     it->Dtmp, it->Stmp, it->gbuf,     it->blk,   it->vtmp,   it->pt_t,  it->pt_q,
                     it->pt_l, it->rec_h, it->rec_t,   it->rec_x, it->rec_th, it->rec_la, it->rec_mu,
-                    it->rec_v, it->zfast, it->bt, it->ftot, it->gdense, it->bseg_lo, it->bseg_hi, it->hlo, it->hhi, it->err_atol, it->tol_atol};
+                    it->rec_v, it->zfast, it->bt, it->ftot, it->gdense, it->bseg_lo, it->bseg_hi, it->hlo, it->hhi, it->err_atol, it->tol_atol, it->slide_tmp};
   for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); i++) free(bufs[i]);
   for (fesd__saved *b = &it->bk; b <= &it->bk_sub; b++) {
     double *saved[] = {b->x, b->lam, b->th, b->blk, b->Sx, b->Su, b->ldp};
@@ -271,6 +271,7 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   it->plan_after = malloc(cp * nth);
   it->bseg = malloc((cp + 2) * sizeof(int));
   it->fil_th = dalloc(nth, &fail);
+  it->slide_tmp = dalloc(2 * nx, &fail);
   it->fil_a = malloc(nth);
   if (!it->fil_a) fail = 1;
   const int gq = s * nx; /* the guess's stage Newton: small systems only */

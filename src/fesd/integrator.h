@@ -94,6 +94,7 @@ struct fesd_integrator {
   double *gn, *gn_key, *gn_memo;
   int gn_memo_ok;
   double *fil_th;         /* nth: multipliers of an alternative (verify.c) */
+  double *slide_tmp;      /* 2 nx: the coupled sliding multipliers (fesd__stage_theta) */
   unsigned char *fil_a;   /* nth: its active flags */
   int *gn_piv;
   double *ftot, *gdense;     /* nx: a total field; a dense gradient kept zero between uses */
