@@ -70,7 +70,7 @@ void fesd_free(fesd_integrator **itp) {
   free(it->log);
   free(it->log_pool);
   double *bufs[] = {it->x,  it->lam00, it->theta_prev, it->u_cur, it->ws_blk, it->z,     it->z0,
-                    it->zpred, it->zp, it->raw,       it->lb,    it->ub,     it->Sx,    it->Su,
+                    it->zpred, it->zp, it->raw,       it->Sx,    it->Su,
                     it->Dtmp, it->Stmp, it->gbuf,     it->blk,   it->vtmp,   it->pt_t,  it->pt_q,
                     it->pt_l, it->rec_h, it->rec_t,   it->rec_x, it->rec_th, it->rec_la, it->rec_mu,
                     it->rec_v, it->zfast, it->bt, it->ftot, it->gdense, it->bseg_lo, it->bseg_hi, it->hlo, it->hhi, it->err_atol, it->tol_atol};
@@ -214,8 +214,6 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   it->zpred = dalloc(n, &fail);
   it->zp = dalloc(n, &fail);
   it->raw = dalloc((size_t)S->n_raw, &fail);
-  it->lb = dalloc(n, &fail);
-  it->ub = dalloc(n, &fail);
   /* sensitivity storage is O(n_x^2): only when asked for */
   const size_t sx = settings->sensitivities ? nx : 1;
   for (fesd__saved *b = &it->bk; b <= &it->bk_sub; b++) {

@@ -81,7 +81,7 @@ struct fesd_integrator {
   double *x, *lam00, *theta_prev, *u_cur, *ws_blk; /* ws_blk: last stage block of the last step */
   int have_state, have_ws, have_prev_theta;
   /* step data (sized for N_cap elements) */
-  double *z, *z0, *zpred, *zp, *raw, *lb, *ub;
+  double *z, *z0, *zpred, *zp, *raw;
   unsigned char *eq_active, *pair_mode, *raw_border, *col_border;
   fesd__saved bk, bk_sub; /* step start, sub-step start */
   /* sensitivities */
