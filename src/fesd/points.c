@@ -98,6 +98,13 @@ static int stage_point(fesd__system *S, int p, double t, const double *X, int wa
   return FESD_OK;
 }
 
+const fesd__point_eval *fesd__system_record(const fesd__system *S, int p, double t, const double *X, int level) {
+  const size_t su = (size_t)S->nu * sizeof(double);
+  if (S->pt_lvl[p] < level || S->pt_t[p] != t || memcmp(S->pt_X + (size_t)p * S->nx, X, (size_t)S->nx * sizeof(double)))
+    return NULL;
+  return su && memcmp(S->pt_u, S->u, su) ? NULL : &S->pe[p];
+}
+
 const fesd__point_eval *fesd__system_stage_eval(fesd__system *S, int p, double t, const double *X, int want_jac) {
   S->pc_valid = 0; /* pe[p] may change */
   S->status = stage_point(S, p, t, X, want_jac, 0);

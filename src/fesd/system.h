@@ -109,6 +109,9 @@ typedef struct {
 /* Stage point p evaluated at (t, X) into pe[p] (with Jacobians if want_jac), unless it holds
  * that already; NULL if a callback failed (its status in S->status). */
 const fesd__point_eval *fesd__system_stage_eval(fesd__system *S, int p, double t, const double *X, int want_jac);
+/* The record of stage point p if it holds (t, X) at level >= level (1: values, 2: with
+ * x-Jacobians), NULL otherwise. */
+const fesd__point_eval *fesd__system_record(const fesd__system *S, int p, double t, const double *X, int level);
 /* Nothing evaluated before is reused (the callbacks' user data may have changed). */
 void fesd__system_points_reset(fesd__system *S);
 
