@@ -89,8 +89,8 @@ int fesd__stage_newton(fesd_integrator *it, double *z, int n, const double *xn, 
       for (int i = 0; i < nth; i++)
         if (th[i] != 0.0) fesd__F_axpy(m, &pe, i, -th[i], g);
       for (int r = 0; r < nx; r++) {
-        gmax = fmax(gmax, fabs(g[r]));
-        vmax = fmax(vmax, fabs(v[r]));
+        gmax = fesd__fmax(gmax, fabs(g[r]));
+        vmax = fesd__fmax(vmax, fabs(v[r]));
       }
     }
     if (!(gmax <= 1e300)) break; /* NaN or overflow: the sweeps decide */

@@ -124,27 +124,6 @@ static int solve(fesd_integrator *it, double *z, double sigma, double tol, int m
   return st;
 }
 
-/* Max over elements, modes and stage pairs m != m' of theta_{n,m,i} lambda_{n,m',i}
- * (boundary lambdas included, weighted like the rows): the sparse cross complementarity
- * (eq. cross_cc_true). */
-double fesd__cc_max(const fesd__system *S, const double *z) {
-  double worst = 0;
-  for (int n = 0; n < S->N; n++) {
-    const double *L = fesd__left_lambda(S, z, n);
-    const double *R = S->bp ? fesd__right_lambda(S, z, n) : NULL;
-    for (int i = 0; i < S->nth; i++)
-      for (int m = 0; m < S->s; m++) {
-        double th = z[fesd__th(S, n, m) + i];
-        if (th <= 0) continue;
-        double lmax = fmax(L[i], R ? R[i] : 0.0);
-        for (int mp = 0; mp < S->s; mp++)
-          if (mp != m) lmax = fmax(lmax, z[fesd__la(S, n, mp) + i]);
-        worst = fmax(worst, th * lmax * S->wth[i]);
-      }
-  }
-  return worst;
-}
-
 /* ---------- FB path: equal-h FB solve, predictor, reduced FB solve ---------- */
 
 /* z0 holds the initial guess (N_FE layout); on success z is a converged solution. */
