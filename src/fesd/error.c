@@ -105,7 +105,7 @@ int fesd__error_estimate(fesd_integrator *it, const double *z, double rtol, cons
       double d = it->err_e0 * (it->err_e0 != 0.0 ? f0[r] : 0.0);
       for (int j = 0; j < s; j++) d += it->err_e[j] * z[fesd__v(S, n, j) + r];
       d *= h;
-      const double sc = atol[r] + rtol * fmax(fabs(xn[r]), fabs(x1[r]));
+      const double sc = atol[r] + rtol * fesd__fmax(fabs(xn[r]), fabs(x1[r]));
       const double e = sc > 0 ? d / sc : (d != 0 ? INFINITY : 0.0);
       sum += e * e;
     }
