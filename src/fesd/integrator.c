@@ -278,6 +278,7 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
     it->gn_key = dalloc(2 * nk, &fail);
     it->gn_memo = it->gn_key ? it->gn_key + nk : NULL;
     it->gn_piv = malloc((size_t)gq * sizeof(int));
+    it->gn_full_at = 1;
     if (!it->gn_piv) fail = 1;
   }
   int max_nf = 0;

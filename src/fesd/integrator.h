@@ -93,6 +93,7 @@ struct fesd_integrator {
    * valid while gn_memo_ok; both in the block gn_key). NULL: too large */
   double *gn, *gn_key, *gn_memo;
   int gn_memo_ok;
+  int gn_full_at; /* the Newton pass that converged last (evaluated in full: stage_newton.c) */
   double *fil_th;         /* nth: multipliers of an alternative (verify.c) */
   unsigned char *fil_a;   /* nth: its active flags */
   int *gn_piv;
