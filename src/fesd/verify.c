@@ -54,11 +54,20 @@ void fesd__interior_setup(fesd_integrator *it) {
 
 void fesd__poly_state(const fesd_integrator *it, const double *z, int n, const double *w, double *x) {
   const fesd__system *S = &it->sys;
-  const double *xn = n == 0 ? S->x0 : z + S->xo[n - 1], h = z[S->ho[n]];
-  memcpy(x, xn, (size_t)S->nx * sizeof(double));
-  for (int j = 0; j < S->s; j++) {
-    const double hw = h * w[j], *v = z + fesd__v(S, n, j);
-    for (int r = 0; r < S->nx; r++) x[r] += hw * v[r];
+  const int nx = S->nx, s = S->s, sb = S->sb;
+  const double *xn = n == 0 ? S->x0 : z + S->xo[n - 1], h = z[S->ho[n]], *ve = z + S->el[n];
+  if (nx <= s) { /* per component: x_n, then the stages in order (a short vector) */
+    for (int r = 0; r < nx; r++) {
+      double a = xn[r];
+      for (int j = 0; j < s; j++) a += h * w[j] * ve[j * sb + r];
+      x[r] = a;
+    }
+    return;
+  }
+  memcpy(x, xn, (size_t)nx * sizeof(double)); /* the same sums, stage by stage over the vector */
+  for (int j = 0; j < s; j++) {
+    const double hw = h * w[j], *v = ve + j * sb;
+    for (int r = 0; r < nx; r++) x[r] += hw * v[r];
   }
 }
 
