@@ -21,7 +21,16 @@ static int stage_key(fesd_integrator *it, const double *z, int n, const double *
   pj.dFdx = it->pscr.dFdx;
   if (fesd__model_eval(m, tn, xn, S->u, &pj)) return 1;
   it->gn_key[0] = h;
-  for (int j = 0; j < S->s; j++) fesd__Jth(m, &pj, z + fesd__th(S, n, j), it->gn_key + 1 + (size_t)j * nnz);
+  for (int j = 0; j < S->s; j++) {
+    const double *th = z + fesd__th(S, n, j), *tp = j > 0 ? z + fesd__th(S, n, j - 1) : NULL;
+    double *J = it->gn_key + 1 + (size_t)j * nnz;
+    int same = tp != NULL; /* the stage before has the same theta (no switch): its J */
+    for (int i = 0; i < S->nth && same; i++) same = th[i] == tp[i];
+    if (same)
+      for (int e = 0; e < nnz; e++) J[e] = J[e - nnz];
+    else
+      fesd__Jth(m, &pj, th, J);
+  }
   return 0;
 }
 
