@@ -547,12 +547,17 @@ int fesd_dense_output(const fesd_integrator *it, double t, double *x) {
 
 void fesd__colloc_weights(const fesd_integrator *it, double tau, double *w) {
   const fesd_tableau *T = &it->tab;
-  for (int j = 0; j < T->s; j++) {
+  const int s = T->s, nq = it->quad.s;
+  double num[FESD_RK_MAX_STAGES][FESD_RK_MAX_STAGES], den[FESD_RK_MAX_STAGES]; /* (the same */
+  for (int q = 0; q < nq; q++) /* differences as inside the product, formed once) */
+    for (int m = 0; m < s; m++) num[q][m] = tau * it->quad.c[q] - T->c[m];
+  for (int j = 0; j < s; j++) {
+    for (int m = 0; m < s; m++) den[m] = T->c[j] - T->c[m];
     w[j] = 0; /* int_0^tau l_j by the Gauss rule (exact: degree s - 1) */
-    for (int q = 0; q < it->quad.s; q++) {
-      double sg = tau * it->quad.c[q], l = 1;
-      for (int m = 0; m < T->s; m++)
-        if (m != j) l *= (sg - T->c[m]) / (T->c[j] - T->c[m]);
+    for (int q = 0; q < nq; q++) {
+      double l = 1;
+      for (int m = 0; m < s; m++)
+        if (m != j) l *= num[q][m] / den[m];
       w[j] += tau * it->quad.b[q] * l;
     }
   }
