@@ -32,7 +32,7 @@ int fesd__update_lambda00(fesd_integrator *it, const double *x, const double *u,
     }
     double gmin = it->gbuf[imin];
     for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) {
-      it->lam00[i] = fmax(it->gbuf[i] - gmin, 0.0);
+      it->lam00[i] = fesd__fmax(it->gbuf[i] - gmin, 0.0);
       if (deriv) {
         memset(t, 0, (size_t)nx * sizeof(double));
         fesd__dg_axpy(m, &pe, i, 1.0, t);

@@ -127,9 +127,9 @@ int fesd__impose_active(fesd_integrator *it, double *z, const unsigned char *act
             th[i] = 0;
             continue;
           }
-          th[i] = fmax(th[i], 0.0);
+          th[i] = fesd__fmax(th[i], 0.0);
           sum += th[i];
-          low = fmin(low, th[i]);
+          low = fesd__fmin(low, th[i]);
           cnt++;
         }
         int uniform = cnt > 0 && (low < 1e-3 * sum || sum <= 0);

@@ -73,24 +73,39 @@ int fesd__error_estimate(fesd_integrator *it, const double *z, double rtol, cons
   const int nx = S->nx, s = S->s, nth = S->nth;
   *err = 0;
   if (!it->err_ok) return FESD_OK;
-  fesd__point_eval pe = fesd__scratch_eval(it);
   double tn = S->t0, *f0 = it->ftot, *th0 = it->gbuf; /* nth */
   for (int n = 0; n < S->N; n++) {
     const double h = z[S->ho[n]], *xn = n == 0 ? S->x0 : z + S->xo[n - 1], *x1 = z + S->xo[n];
     if (it->err_e0 != 0.0) {
-      int st = fesd__model_eval(m, tn, xn, S->u, &pe);
-      if (st) return st;
       unsigned char *a = it->cand; /* the element's active modes (first stage) */
       fesd__act_from_theta(it, z + fesd__th(S, n, 0), a);
-      fesd__stage_theta(it, &pe, a, th0);
-      fesd__total_field(it, &pe, th0, f0);
+      /* f_0 needs the fields, and the switch Jacobians only for a 2-mode sliding mode
+       * (fesd__stage_theta); x_n of a later element is often the last stage point of the one
+       * before (c_s = 1), evaluated already */
+      int slide = 0;
+      for (int k = 0; k < m->nsys && !slide; k++) {
+        int cnt = 0;
+        for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) cnt += a[i];
+        slide = cnt == 2;
+      }
+      const fesd__point_eval *pr = n > 0 ? fesd__system_record(S, n * s - 1, tn, xn, slide ? 2 : 1) : NULL;
+      fesd__point_eval pe = {0};
+      if (!pr) {
+        pe.F = it->pscr.F;
+        pe.dgdx = slide ? it->pscr.dgdx : NULL;
+        int st = fesd__model_eval(m, tn, xn, S->u, &pe);
+        if (st) return st;
+        pr = &pe;
+      }
+      fesd__stage_theta(it, pr, a, th0);
+      fesd__total_field(it, pr, th0, f0);
     }
     double sum = 0;
     for (int r = 0; r < nx; r++) {
       double d = it->err_e0 * (it->err_e0 != 0.0 ? f0[r] : 0.0);
       for (int j = 0; j < s; j++) d += it->err_e[j] * z[fesd__v(S, n, j) + r];
       d *= h;
-      const double sc = atol[r] + rtol * fmax(fabs(xn[r]), fabs(x1[r]));
+      const double sc = atol[r] + rtol * fesd__fmax(fabs(xn[r]), fabs(x1[r]));
       const double e = sc > 0 ? d / sc : (d != 0 ? INFINITY : 0.0);
       sum += e * e;
     }

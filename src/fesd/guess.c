@@ -15,7 +15,7 @@ int fesd__consistent_guess(fesd_integrator *it, double *z) {
   fesd__system *S = &it->sys;
   fesd__model *m = &it->model;
   const int nx = S->nx, nth = S->nth, s = S->s;
-  double *g = it->pscr.g, *X = S->X; /* X: scratch (stage_newton too) */
+  double *g = it->pscr.g, *X = S->X; /* X: scratch of the sweeps (the stage points: S->X + p nx) */
   fesd__system_points_stale(S);
   fesd__point_eval pe = {0}, pg = {0}; /* fields only in the sweeps; indicators once after */
   pe.F = it->pscr.F;
@@ -71,20 +71,21 @@ int fesd__consistent_guess(fesd_integrator *it, double *z) {
     }
     /* lambda, mu from the LP rows at the final stage states */
     for (int j = 0; j < s; j++) {
-      for (int r = 0; r < nx; r++) {
+      double *Xj = S->X + (size_t)(n * s + j) * nx; /* as the stage Newton left it */
+      for (int r = 0; r < nx && !newton_ok; r++) {
         double acc = 0;
         for (int l = 0; l < s; l++) acc += S->tab.A[j][l] * z[fesd__v(S, n, l) + r];
-        X[r] = xn[r] + h * acc;
+        Xj[r] = xn[r] + h * acc;
       }
       /* in full (Jacobians too): the weights of the solve that follows evaluate these points
        * again when the guess is its solution (an ordinary step); g alone if that fails (a
        * failing Jacobian callback is reported by the solve, as without this) */
       const double tj = tn + S->tab.c[j] * h;
-      const fesd__point_eval *pf = fesd__system_stage_eval(S, n * s + j, tj, X, 1);
+      const fesd__point_eval *pf = fesd__system_stage_eval(S, n * s + j, tj, Xj, 1);
       if (pf) {
         memcpy(g, pf->g, (size_t)nth * sizeof(double));
       } else {
-        int st = fesd__model_eval(m, tj, X, S->u, &pg);
+        int st = fesd__model_eval(m, tj, Xj, S->u, &pg);
         if (st) return st;
       }
       const double *th = z + fesd__th(S, n, j);

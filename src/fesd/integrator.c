@@ -70,7 +70,7 @@ void fesd_free(fesd_integrator **itp) {
   free(it->log);
   free(it->log_pool);
   double *bufs[] = {it->x,  it->lam00, it->theta_prev, it->u_cur, it->ws_blk, it->z,     it->z0,
-                    it->zpred, it->zp, it->raw,       it->lb,    it->ub,     it->Sx,    it->Su,
+                    it->zpred, it->zp, it->raw,       it->Sx,    it->Su,
                     it->Dtmp, it->Stmp, it->gbuf,     it->blk,   it->vtmp,   it->pt_t,  it->pt_q,
                     it->pt_l, it->rec_h, it->rec_t,   it->rec_x, it->rec_th, it->rec_la, it->rec_mu,
                     it->rec_v, it->zfast, it->bt, it->ftot, it->gdense, it->bseg_lo, it->bseg_hi, it->hlo, it->hhi, it->err_atol, it->tol_atol, it->slide_tmp};
@@ -214,8 +214,6 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   it->zpred = dalloc(n, &fail);
   it->zp = dalloc(n, &fail);
   it->raw = dalloc((size_t)S->n_raw, &fail);
-  it->lb = dalloc(n, &fail);
-  it->ub = dalloc(n, &fail);
   /* sensitivity storage is O(n_x^2): only when asked for */
   const size_t sx = settings->sensitivities ? nx : 1;
   for (fesd__saved *b = &it->bk; b <= &it->bk_sub; b++) {
@@ -281,6 +279,7 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
     it->gn_key = dalloc(2 * nk, &fail);
     it->gn_memo = it->gn_key ? it->gn_key + nk : NULL;
     it->gn_piv = malloc((size_t)gq * sizeof(int));
+    it->gn_full_at = 1;
     if (!it->gn_piv) fail = 1;
   }
   int max_nf = 0;
@@ -549,12 +548,17 @@ int fesd_dense_output(const fesd_integrator *it, double t, double *x) {
 
 void fesd__colloc_weights(const fesd_integrator *it, double tau, double *w) {
   const fesd_tableau *T = &it->tab;
-  for (int j = 0; j < T->s; j++) {
+  const int s = T->s, nq = it->quad.s;
+  double num[FESD_RK_MAX_STAGES][FESD_RK_MAX_STAGES], den[FESD_RK_MAX_STAGES]; /* (the same */
+  for (int q = 0; q < nq; q++) /* differences as inside the product, formed once) */
+    for (int m = 0; m < s; m++) num[q][m] = tau * it->quad.c[q] - T->c[m];
+  for (int j = 0; j < s; j++) {
+    for (int m = 0; m < s; m++) den[m] = T->c[j] - T->c[m];
     w[j] = 0; /* int_0^tau l_j by the Gauss rule (exact: degree s - 1) */
-    for (int q = 0; q < it->quad.s; q++) {
-      double sg = tau * it->quad.c[q], l = 1;
-      for (int m = 0; m < T->s; m++)
-        if (m != j) l *= (sg - T->c[m]) / (T->c[j] - T->c[m]);
+    for (int q = 0; q < nq; q++) {
+      double l = 1;
+      for (int m = 0; m < s; m++)
+        if (m != j) l *= num[q][m] / den[m];
       w[j] += tau * it->quad.b[q] * l;
     }
   }

@@ -81,7 +81,7 @@ struct fesd_integrator {
   double *x, *lam00, *theta_prev, *u_cur, *ws_blk; /* ws_blk: last stage block of the last step */
   int have_state, have_ws, have_prev_theta;
   /* step data (sized for N_cap elements) */
-  double *z, *z0, *zpred, *zp, *raw, *lb, *ub;
+  double *z, *z0, *zpred, *zp, *raw;
   unsigned char *eq_active, *pair_mode, *raw_border, *col_border;
   fesd__saved bk, bk_sub; /* step start, sub-step start */
   /* sensitivities */
@@ -93,6 +93,7 @@ struct fesd_integrator {
    * valid while gn_memo_ok; both in the block gn_key). NULL: too large */
   double *gn, *gn_key, *gn_memo;
   int gn_memo_ok;
+  int gn_full_at; /* the Newton pass that converged last (evaluated in full: stage_newton.c) */
   double *fil_th;         /* nth: multipliers of an alternative (verify.c) */
   double *slide_tmp;      /* 2 nx: the coupled sliding multipliers (fesd__stage_theta) */
   unsigned char *fil_a;   /* nth: its active flags */
@@ -144,6 +145,7 @@ struct fesd_integrator {
   int n_mid;
   double mid_w[(FESD_RK_MAX_STAGES + 1) * FESD_RK_MAX_STAGES];
   double mid_tau[FESD_RK_MAX_STAGES + 1];
+  int mid_stage[FESD_RK_MAX_STAGES + 1]; /* the stage nearest to each midpoint */
   /* error estimate (error.c): embedded weights (e0 on the field at the element start, e_j on
    * the stages), order of the estimate */
   int err_ok, err_q;
@@ -185,7 +187,7 @@ static inline fesd__point_eval fesd__scratch_eval(const fesd_integrator *it) {
 /* w_j = int_0^tau l_j (Lagrange basis on the nodes c): the collocation polynomial of an
  * element is x_n + h sum_j w_j(tau) v_j. w has s entries. */
 void fesd__colloc_weights(const fesd_integrator *it, double tau, double *w);
-/* Fill n_mid, mid_tau and mid_w (verify.c). */
+/* Fill n_mid, mid_tau, mid_w and mid_stage (verify.c). */
 void fesd__interior_setup(fesd_integrator *it);
 void fesd__save(fesd_integrator *it, fesd__saved *b);
 void fesd__load(fesd_integrator *it, const fesd__saved *b);

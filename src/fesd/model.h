@@ -44,6 +44,11 @@ typedef struct {
   double *dgdu;  /* nth x nu, column-major */
 } fesd__point_eval;
 
+/* fmax and fmin without the libm call (hot loops): the larger (smaller) of a and b, the other
+ * one if one is NaN, b if they compare equal (as glibc's on x86-64: maxsd, minsd). */
+static inline double fesd__fmax(double a, double b) { return a > b || b != b ? a : b; }
+static inline double fesd__fmin(double a, double b) { return a < b || b != b ? a : b; }
+
 int fesd__model_init(fesd__model *m, const fesd_model *user);
 void fesd__model_free(fesd__model *m);
 /* Allocate / free the arrays of a point evaluation for this model. */

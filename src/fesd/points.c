@@ -98,6 +98,13 @@ static int stage_point(fesd__system *S, int p, double t, const double *X, int wa
   return FESD_OK;
 }
 
+const fesd__point_eval *fesd__system_record(const fesd__system *S, int p, double t, const double *X, int level) {
+  const size_t su = (size_t)S->nu * sizeof(double);
+  if (S->pt_lvl[p] < level || S->pt_t[p] != t || memcmp(S->pt_X + (size_t)p * S->nx, X, (size_t)S->nx * sizeof(double)))
+    return NULL;
+  return su && memcmp(S->pt_u, S->u, su) ? NULL : &S->pe[p];
+}
+
 const fesd__point_eval *fesd__system_stage_eval(fesd__system *S, int p, double t, const double *X, int want_jac) {
   S->pc_valid = 0; /* pe[p] may change */
   S->status = stage_point(S, p, t, X, want_jac, 0);
@@ -108,6 +115,7 @@ int fesd__system_points(fesd__system *S, const double *z, int want_jac) {
   const int N = S->N, s = S->s, nx = S->nx, nth = S->nth, nu = S->nu;
   fesd__model *m = S->model;
   if (points_cached(S, z, want_jac)) return FESD_OK;
+  S->pc_hcol = 0;
   double *K = S->tmp; /* K_j = sum_l a_jl v_l */
   double tn = S->t0;
   for (int n = 0; n < N; n++) {
@@ -131,9 +139,7 @@ int fesd__system_points(fesd__system *S, const double *z, int want_jac) {
         const double *th = z + fesd__th(S, n, j);
         double *J = S->Jth + (size_t)p * m->pf_nnz;
         fesd__Jth(m, &pe, th, J);
-        fesd__pf_mv(m, J, K, S->JK + (size_t)p * nx);
-        if (!lk)
-          for (int i = 0; i < nth; i++) S->KG[(size_t)p * nth + i] = fesd__dg_dot(m, &pe, i, K);
+        memcpy(S->JK + (size_t)p * nx, K, (size_t)nx * sizeof(double)); /* fesd__system_points_hcol */
         if (S->want_u && nu > 0) {
           double *Ju = S->Juth + (size_t)p * nx * nu;
           memset(Ju, 0, (size_t)nx * nu * sizeof(double));
@@ -159,4 +165,22 @@ int fesd__system_points(fesd__system *S, const double *z, int want_jac) {
   }
   S->pc_valid = 1;
   return FESD_OK;
+}
+
+/* JK and KG of every stage point (look-ahead KG: look_ahead) from the K_j that
+ * fesd__system_points left in JK: only a Newton Jacobian has an h column, the row weights and
+ * residuals of a converged guess need neither. */
+void fesd__system_points_hcol(fesd__system *S) {
+  if (S->pc_hcol) return;
+  const fesd__model *m = S->model;
+  const int nx = S->nx, nth = S->nth, ns = S->N * S->s;
+  double *K = S->tmp;
+  for (int p = 0; p < ns; p++) {
+    double *JK = S->JK + (size_t)p * nx;
+    memcpy(K, JK, (size_t)nx * sizeof(double));
+    fesd__pf_mv(m, S->Jth + (size_t)p * m->pf_nnz, K, JK);
+    if (!(S->look && p % S->s == 0))
+      for (int i = 0; i < nth; i++) S->KG[(size_t)p * nth + i] = fesd__dg_dot(m, &S->pe[p], i, K);
+  }
+  S->pc_hcol = 1;
 }

@@ -21,7 +21,16 @@ static int stage_key(fesd_integrator *it, const double *z, int n, const double *
   pj.dFdx = it->pscr.dFdx;
   if (fesd__model_eval(m, tn, xn, S->u, &pj)) return 1;
   it->gn_key[0] = h;
-  for (int j = 0; j < S->s; j++) fesd__Jth(m, &pj, z + fesd__th(S, n, j), it->gn_key + 1 + (size_t)j * nnz);
+  for (int j = 0; j < S->s; j++) {
+    const double *th = z + fesd__th(S, n, j), *tp = j > 0 ? z + fesd__th(S, n, j - 1) : NULL;
+    double *J = it->gn_key + 1 + (size_t)j * nnz;
+    int same = tp != NULL; /* the stage before has the same theta (no switch): its J */
+    for (int i = 0; i < S->nth && same; i++) same = th[i] == tp[i];
+    if (same)
+      for (int e = 0; e < nnz; e++) J[e] = J[e - nnz];
+    else
+      fesd__Jth(m, &pj, th, J);
+  }
   return 0;
 }
 
@@ -61,40 +70,50 @@ static int stage_factor(fesd_integrator *it) {
  * need 8-16 passes or diverge. Returns 0 when the stage residual is at round-off level
  * (1e-14 of the stage derivatives), 1 otherwise (v is then left as it was: the sweeps take
  * over). The first residual is checked before any Jacobian: a converged guess costs s
- * evaluations. */
+ * evaluations. The stage states of the last pass stay in S->X + (n s + j) nx. */
 int fesd__stage_newton(fesd_integrator *it, double *z, int n, const double *xn, double h, double tn) {
   fesd__system *S = &it->sys;
   fesd__model *m = &it->model;
   const int nx = S->nx, s = S->s, q = s * nx, nth = S->nth;
   if (!it->gn || q > FESD__GN_MAX || S->tab.is_explicit) return 1;
-  double *G = it->gn + (size_t)q * q, *V0 = G + q, *X = S->X;
-  fesd__point_eval pe = {0};
-  pe.F = it->pscr.F;
+  double *G = it->gn + (size_t)q * q, *V0 = G + q;
   for (int j = 0; j < s; j++) memcpy(V0 + j * nx, z + fesd__v(S, n, j), (size_t)nx * sizeof(double));
   double gprev = INFINITY;
   int factored = 0;
   for (int iter = 0; iter < 6; iter++) {
     double gmax = 0, vmax = 0;
+    /* the pass that converged last time is evaluated in full into the stage records: when it
+     * converges again, the LP rows and the weights find every point there (guess.c) */
+    const int full = iter >= it->gn_full_at;
     for (int j = 0; j < s; j++) {
-      const double *v = z + fesd__v(S, n, j), *th = z + fesd__th(S, n, j);
+      const double *v = z + fesd__v(S, n, j), *th = z + fesd__th(S, n, j), tj = tn + S->tab.c[j] * h;
+      double *X = S->X + (size_t)(n * s + j) * nx; /* kept for the LP rows */
       for (int r = 0; r < nx; r++) {
         double acc = 0;
         for (int l = 0; l < s; l++) acc += S->tab.A[j][l] * z[fesd__v(S, n, l) + r];
         X[r] = xn[r] + h * acc;
       }
-      int st = fesd__model_fields_active(m, tn + S->tab.c[j] * h, X, S->u, pe.F, th);
-      if (st) goto restore; /* a failing callback: the sweeps report it */
+      const fesd__point_eval *pf = full ? fesd__system_stage_eval(S, n * s + j, tj, X, 1) : NULL;
+      fesd__point_eval pe = {0};
+      if (!pf) { /* the fields alone (also when a Jacobian or switch callback failed there) */
+        pe.F = it->pscr.F;
+        if (fesd__model_fields_active(m, tj, X, S->u, pe.F, th)) goto restore; /* the sweeps report it */
+        pf = &pe;
+      }
       double *g = G + j * nx;
       memcpy(g, v, (size_t)nx * sizeof(double));
       for (int i = 0; i < nth; i++)
-        if (th[i] != 0.0) fesd__F_axpy(m, &pe, i, -th[i], g);
+        if (th[i] != 0.0) fesd__F_axpy(m, pf, i, -th[i], g);
       for (int r = 0; r < nx; r++) {
-        gmax = fmax(gmax, fabs(g[r]));
-        vmax = fmax(vmax, fabs(v[r]));
+        gmax = fesd__fmax(gmax, fabs(g[r]));
+        vmax = fesd__fmax(vmax, fabs(v[r]));
       }
     }
     if (!(gmax <= 1e300)) break; /* NaN or overflow: the sweeps decide */
-    if (gmax <= 1e-14 * vmax || gmax == 0.0) return 0;
+    if (gmax <= 1e-14 * vmax || gmax == 0.0) {
+      it->gn_full_at = iter;
+      return 0;
+    }
     if (gmax > 0.5 * gprev) break; /* not converging like Newton */
     gprev = gmax;
     if (!factored && (stage_key(it, z, n, xn, h, tn) || stage_factor(it))) break;

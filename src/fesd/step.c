@@ -23,6 +23,7 @@
 #include "common/timer.h"
 #include "fesd/integrator.h"
 #include "fesd/step.h"
+#include "ncp/ncp_defer.h"
 
 /* A callback failed (error code, NaN/Inf) or memory ran out: no other path can succeed. */
 static int hard_failure(int st) {
@@ -75,18 +76,15 @@ static int rows_select(fesd_integrator *it, const int *switch_at) {
   return st ? st : fesd_ncp_set_rows(it->ncp, it->eq_active, it->pair_mode);
 }
 
-/* Element lengths in [1e-9 T, T], or in the plan's bounds (fesd__plan_layout). */
+/* Element lengths in [1e-9 T, T], or in the plan's bounds (fesd__plan_layout); the other
+ * unknowns of a level's workspace are never bounded (as set up). */
 static int set_h_bounds(fesd_integrator *it, double T, int plan) {
   fesd__system *S = &it->sys;
-  for (int i = 0; i < S->n; i++) {
-    it->lb[i] = -INFINITY;
-    it->ub[i] = INFINITY;
-  }
   for (int n = 0; n < S->N; n++) {
-    it->lb[S->ho[n]] = plan ? it->hlo[n] : 1e-9 * T;
-    it->ub[S->ho[n]] = plan ? it->hhi[n] : T;
+    int st = fesd__ncp_set_bound(it->ncp, S->ho[n], plan ? it->hlo[n] : 1e-9 * T, plan ? it->hhi[n] : T);
+    if (st) return st;
   }
-  return fesd_ncp_set_bounds(it->ncp, it->lb, it->ub);
+  return FESD_OK;
 }
 
 static void accumulate(fesd_step_info *info, const fesd_ncp_info *ni) {
@@ -133,27 +131,6 @@ static int solve(fesd_integrator *it, double *z, double sigma, double tol, int m
     info->failed_callback = it->model.failed;
   }
   return st;
-}
-
-/* Max over elements, modes and stage pairs m != m' of theta_{n,m,i} lambda_{n,m',i}
- * (boundary lambdas included, weighted like the rows): the sparse cross complementarity
- * (eq. cross_cc_true). */
-double fesd__cc_max(const fesd__system *S, const double *z) {
-  double worst = 0;
-  for (int n = 0; n < S->N; n++) {
-    const double *L = fesd__left_lambda(S, z, n);
-    const double *R = S->bp ? fesd__right_lambda(S, z, n) : NULL;
-    for (int i = 0; i < S->nth; i++)
-      for (int m = 0; m < S->s; m++) {
-        double th = z[fesd__th(S, n, m) + i];
-        if (th <= 0) continue;
-        double lmax = fmax(L[i], R ? R[i] : 0.0);
-        for (int mp = 0; mp < S->s; mp++)
-          if (mp != m) lmax = fmax(lmax, z[fesd__la(S, n, mp) + i]);
-        worst = fmax(worst, th * lmax * S->wth[i]);
-      }
-  }
-  return worst;
 }
 
 /* ---------- FB path: equal-h FB solve, predictor, reduced FB solve ---------- */

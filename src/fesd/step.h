@@ -8,8 +8,6 @@
 /* Advance by T (sub-steps at planned switches, recursive halving on failure up to
  * settings.max_splits). */
 int fesd__substep(fesd_integrator *it, const double *u, double T, int depth, fesd_step_info *info);
-/* Max sparse cross-complementarity product of z (weighted: units of the row scaling). */
-double fesd__cc_max(const fesd__system *S, const double *z);
 /* lambda00 = g(x) - min g per subsystem (and d/d(x,u) into sys.lam00_dp when deriv). */
 int fesd__update_lambda00(fesd_integrator *it, const double *x, const double *u, int deriv);
 
@@ -32,6 +30,8 @@ void fesd__normal_components(fesd_integrator *it, const fesd__point_eval *pe, co
                              const double *ftot, int i, int j, double *ai, double *aj);
 
 /* ---- verify.c ---- */
+/* Max sparse cross-complementarity product of z (weighted: units of the row scaling). */
+double fesd__cc_max(const fesd__system *S, const double *z);
 /* Earliest violation of the active sets act (N*s blocks) in z over all subsystems (v) and, when
  * per_sys is non-NULL, the earliest of each subsystem (nsys entries). strict (standard method):
  * every stage is checked. Collocation methods are also checked between the stage points (the

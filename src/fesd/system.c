@@ -443,7 +443,10 @@ int fesd__system_eval(const double *z, double *raw, double *jac, void *ctx) {
         raw[S->n_eq + S->n_pair + p] = z[fesd__la(S, n, j) + i];
       }
   for (int r = 0; r < S->n_raw; r++) raw[r] *= S->wraw[r];
-  if (jac) emit_values(S, z, jac);
+  if (jac) {
+    fesd__system_points_hcol(S);
+    emit_values(S, z, jac);
+  }
   return 0;
 }
 

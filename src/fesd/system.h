@@ -97,6 +97,7 @@ typedef struct {
    * X or pe outside fesd__system_points clears pc_valid (fesd__system_points_stale). */
   double *pc_z, *pc_xu, pc_t0;
   int pc_valid, pc_jac, pc_want_u;
+  int pc_hcol; /* JK and KG of these points computed (fesd__system_points_hcol) */
   /* What pe[p] of stage point p holds: evaluated at (pt_t[p], pt_X[p]) with level pt_lvl[p]
    * (0 nothing reusable, 1 values, 2 with x-Jacobians, 3 also u-Jacobians). The consistent
    * guess evaluates the stage points in full for its LP rows, and the weights then reuse
@@ -108,6 +109,9 @@ typedef struct {
 /* Stage point p evaluated at (t, X) into pe[p] (with Jacobians if want_jac), unless it holds
  * that already; NULL if a callback failed (its status in S->status). */
 const fesd__point_eval *fesd__system_stage_eval(fesd__system *S, int p, double t, const double *X, int want_jac);
+/* The record of stage point p if it holds (t, X) at level >= level (1: values, 2: with
+ * x-Jacobians), NULL otherwise. */
+const fesd__point_eval *fesd__system_record(const fesd__system *S, int p, double t, const double *X, int level);
 /* Nothing evaluated before is reused (the callbacks' user data may have changed). */
 void fesd__system_points_reset(fesd__system *S);
 
@@ -145,8 +149,11 @@ const double *fesd__right_lambda(const fesd__system *S, const double *z, int n);
 const double *fesd__left_lambda(const fesd__system *S, const double *z, int n);
 
 /* Evaluate the model at every stage point (and boundary LP point) of z, with Jacobians when
- * want_jac (fills pe, X, Jth, JK, KG). */
+ * want_jac (fills pe, X, Jth; JK and KG when a Jacobian asks for them). */
 int fesd__system_points(fesd__system *S, const double *z, int want_jac);
+/* JK and KG (the h column of the stage rows) of the points of the last fesd__system_points
+ * with Jacobians; until then JK holds K_j. */
+void fesd__system_points_hcol(fesd__system *S);
 /* Row weights at z (weights.c): 1 / the size of the terms of each row at z. */
 int fesd__system_weights(fesd__system *S, const double *z);
 /* Forget the reference sizes (a new initial state); fold the sizes of the last weighting (an

@@ -45,16 +45,29 @@ void fesd__interior_setup(fesd_integrator *it) {
   for (int p = 0; p + 1 < nn; p++) {
     it->mid_tau[p] = 0.5 * (nodes[p] + nodes[p + 1]);
     fesd__colloc_weights(it, it->mid_tau[p], it->mid_w + p * FESD_RK_MAX_STAGES);
+    int jn = 0;
+    for (int j = 1; j < T->s; j++)
+      if (fabs(T->c[j] - it->mid_tau[p]) < fabs(T->c[jn] - it->mid_tau[p])) jn = j;
+    it->mid_stage[p] = jn;
   }
 }
 
 void fesd__poly_state(const fesd_integrator *it, const double *z, int n, const double *w, double *x) {
   const fesd__system *S = &it->sys;
-  const double *xn = n == 0 ? S->x0 : z + S->xo[n - 1], h = z[S->ho[n]];
-  memcpy(x, xn, (size_t)S->nx * sizeof(double));
-  for (int j = 0; j < S->s; j++) {
-    const double hw = h * w[j], *v = z + fesd__v(S, n, j);
-    for (int r = 0; r < S->nx; r++) x[r] += hw * v[r];
+  const int nx = S->nx, s = S->s, sb = S->sb;
+  const double *xn = n == 0 ? S->x0 : z + S->xo[n - 1], h = z[S->ho[n]], *ve = z + S->el[n];
+  if (nx <= s) { /* per component: x_n, then the stages in order (a short vector) */
+    for (int r = 0; r < nx; r++) {
+      double a = xn[r];
+      for (int j = 0; j < s; j++) a += h * w[j] * ve[j * sb + r];
+      x[r] = a;
+    }
+    return;
+  }
+  memcpy(x, xn, (size_t)nx * sizeof(double)); /* the same sums, stage by stage over the vector */
+  for (int j = 0; j < s; j++) {
+    const double hw = h * w[j], *v = ve + j * sb;
+    for (int r = 0; r < nx; r++) x[r] += hw * v[r];
   }
 }
 
@@ -366,11 +379,7 @@ static int scan_interior(fesd_integrator *it, const double *z, const unsigned ch
       const double t = tn + it->mid_tau[p] * h;
       int st = fesd__model_eval(m, S->t0 + t, x, S->u, &q);
       if (st) return st;
-      /* nearest stage for the thetas */
-      int jn = 0;
-      for (int j = 1; j < s; j++)
-        if (fabs(S->tab.c[j] - it->mid_tau[p]) < fabs(S->tab.c[jn] - it->mid_tau[p])) jn = j;
-      const double *th = z + fesd__th(S, n, jn);
+      const double *th = z + fesd__th(S, n, it->mid_stage[p]); /* the nearest stage's */
       if (sliding) fesd__total_field(it, &q, th, it->ftot);
       for (int k = 0; k < m->nsys; k++) {
         double gact = INFINITY, gin = INFINITY;
@@ -412,6 +421,38 @@ int fesd__scan(fesd_integrator *it, const double *z, const unsigned char *act, i
   for (int k = 0; k < K; k++)
     if (ps[k].found) note(v, &ps[k]);
   return st;
+}
+
+/* Max over elements, modes and stage pairs m != m' of theta_{n,m,i} lambda_{n,m',i}
+ * (boundary lambdas included, weighted like the rows): the sparse cross complementarity
+ * (eq. cross_cc_true). */
+double fesd__cc_max(const fesd__system *S, const double *z) {
+  const int s = S->s, sb = S->sb, nx = S->nx, nth = S->nth;
+  double worst = 0;
+  for (int n = 0; n < S->N; n++) {
+    const double *L = fesd__left_lambda(S, z, n);
+    const double *R = S->bp ? fesd__right_lambda(S, z, n) : NULL;
+    const double *th = z + S->el[n] + nx, *la = th + nth; /* stage m: + m sb */
+    for (int i = 0; i < nth; i++) {
+      /* the largest stage lambda and the largest but the one at stage m1 (the max over the
+       * stages m' != m of every m without a loop over them) */
+      double l1 = -INFINITY, l2 = -INFINITY;
+      int m1 = -1;
+      for (int m = 0; m < s; m++) {
+        const double l = la[m * sb + i];
+        if (l > l1) l2 = l1, l1 = l, m1 = m;
+        else if (l > l2) l2 = l;
+      }
+      const double base = fesd__fmax(L[i], R ? R[i] : 0.0);
+      for (int m = 0; m < s; m++) {
+        const double t = th[m * sb + i];
+        if (t <= 0) continue;
+        const double lmax = fesd__fmax(base, m == m1 ? l2 : l1);
+        worst = fesd__fmax(worst, t * lmax * S->wth[i]);
+      }
+    }
+  }
+  return worst;
 }
 
 int fesd__verify(fesd_integrator *it, const double *z, double *ccm) {

@@ -86,16 +86,18 @@ int fesd__system_weights(fesd__system *S, const double *z) {
         mV[r] = amax(mV[r], w[rV + r]);
       }
       for (int k = 0; k < nsys; k++) {
-        const int nf = m->nf[k], off = m->th_off[k];
-        const double *blk = pe->dgdx + m->dgoff[k];
+        const int nf = m->nf[k], off = m->th_off[k], nc = m->ncol[k], *cols = m->cols[k];
+        const double *blk = pe->dgdx + m->dgoff[k], amu = fabs(mu[k]);
+        double wk = S->wG[k];
         for (int li = 0; li < nf; li++) {
           double a = 0;
-          for (int c = 0; c < m->ncol[k]; c++) a += fabs(blk[(size_t)c * nf + li]) * xi[m->cols[k][c]];
+          for (int c = 0; c < nc; c++) a += fabs(blk[(size_t)c * nf + li]) * xi[cols[c]];
           const int i = off + li;
-          a = amax(amax(a, fabs(pe->g[i])), amax(fabs(la[i]), fabs(mu[k])));
+          a = amax(amax(a, fabs(pe->g[i])), amax(fabs(la[i]), amu));
           w[rG + i] = a;
-          S->wG[k] = amax(S->wG[k], a);
+          wk = amax(wk, a);
         }
+        S->wG[k] = wk;
         w[rS + k] = 1.0;
       }
     }

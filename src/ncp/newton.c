@@ -224,7 +224,7 @@ static int stage(fesd_ncp *ws, double *z, double sigma, double tol, fesd__ncp_st
   *cached = 0;
   fesd__ncp_residual(ws, ws->raw_c, sigma, ws->F_c);
   ss.nrm = norm_inf(ws->F_c, ws->m);
-  ss.f2 = dot(ws->F_c, ws->F_c, ws->m);
+  ss.f2 = ss.nrm <= tol ? 0.0 : dot(ws->F_c, ws->F_c, ws->m); /* the iterations' merit only */
 
   double nrm1 = INFINITY; /* after the first iteration (the progress check) */
   for (int it = 0;; it++) {

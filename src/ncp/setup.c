@@ -291,3 +291,12 @@ const char *fesd_ncp_backend_name(int backend) {
 int fesd__ncp_nomem_count(const fesd_ncp *ws) { return ws ? ws->nomem : 0; }
 
 void fesd__ncp_defer_analysis(fesd_ncp *ws) { ws->defer = 1; }
+
+int fesd__ncp_set_bound(fesd_ncp *ws, int i, double lo, double hi) {
+  if (!ws) return FESD_ERR_NULL;
+  if (i < 0 || i >= ws->n || isnan(lo) || isnan(hi) || lo > hi) return FESD_ERR_INVALID_ARG;
+  ws->lb[i] = lo;
+  ws->ub[i] = hi;
+  ws->has_box = 1;
+  return FESD_OK;
+}
