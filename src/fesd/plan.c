@@ -18,8 +18,6 @@
 
 /* Active sets tried after one switch before the plan gives up on it. */
 #define MAX_TRIES 4
-/* A sub-step ends in a gap between switches at least this fraction of the widest one. */
-#define CUT_GAP 0.1
 /* A switch predicted this close to the step start (fraction of T) happens at the start. */
 #define AT_START 1e-9
 
@@ -43,7 +41,7 @@ static void swap_switch(fesd_integrator *it, int a, int b) {
   memcpy(pb, tmp, (size_t)it->nth);
 }
 
-static void remove_switch(fesd_integrator *it, int e) {
+void fesd__plan_remove(fesd_integrator *it, int e) {
   for (int q = e; q + 1 < it->n_plan; q++) swap_switch(it, q, q + 1);
   it->n_plan--;
 }
@@ -51,15 +49,15 @@ static void remove_switch(fesd_integrator *it, int e) {
 /* Drop the switches of subsystem k after time t. */
 static void drop_after(fesd_integrator *it, int k, double t) {
   for (int e = it->n_plan - 1; e >= 0; e--)
-    if (it->plan[e].sys == k && it->plan[e].t > t) remove_switch(it, e);
+    if (it->plan[e].sys == k && it->plan[e].t > t) fesd__plan_remove(it, e);
 }
 
 void fesd__plan_truncate(fesd_integrator *it, double t) {
   for (int e = it->n_plan - 1; e >= 0; e--)
-    if (it->plan[e].t >= t) remove_switch(it, e);
+    if (it->plan[e].t >= t) fesd__plan_remove(it, e);
 }
 
-static void sort_plan(fesd_integrator *it) {
+void fesd__plan_sort(fesd_integrator *it) {
   for (int a = 1; a < it->n_plan; a++)
     for (int b = a; b > 0 && it->plan[b].t < it->plan[b - 1].t; b--) swap_switch(it, b, b - 1);
 }
@@ -88,7 +86,7 @@ static int cluster(fesd_integrator *it, double T, int *first_of) {
 int fesd__plan_layout(fesd_integrator *it, double T, double *z) {
   fesd__system *S = &it->sys;
   const int nth = it->nth, s = it->s;
-  sort_plan(it);
+  fesd__plan_sort(it);
   int *first_of = it->kb;
   const int nb = cluster(it, T, first_of);
   if (nb + 1 > it->N_cap) return FESD_ERR_TOO_MANY_SWITCHES;
@@ -184,37 +182,6 @@ void fesd__plan_times(fesd_integrator *it, const double *z) {
     for (int n = 0; n < it->plan[e].kb; n++) t += z[S->ho[n]];
     it->plan[e].t = t;
   }
-}
-
-/* Where a sub-step ends between two predicted switches at ta < tb of a (sub)step of length T:
- * the dyadic fraction T k / 2^m with the smallest m in the middle half of (ta, tb). The
- * predictions move smoothly with the step's start state and controls; a cut that followed them
- * (the midpoint) would make the step map depend on them through the sub-step lengths, a term
- * the sensitivities of the sub-steps do not contain (measured: dx/dx0 off by 5e-5 from
- * differences of the map, Radau IIA s = 2, an entry and an exit in one step of 0.67). The
- * dyadic point is constant while the middle half does not reach another one. */
-static double dyadic_cut(double ta, double tb, double T) {
-  const double a = (ta + 0.25 * (tb - ta)) / T, b = (tb - 0.25 * (tb - ta)) / T;
-  for (int m = 1; m <= 52; m++) {
-    const double k = ceil(ldexp(a, m)), c = ldexp(k, -m);
-    if (c < b) return T * c;
-  }
-  return 0.5 * (ta + tb);
-}
-
-double fesd__plan_cut(fesd_integrator *it, int n_max) {
-  sort_plan(it);
-  if (it->n_plan <= n_max) return it->sys.T;
-  /* the last gap at least CUT_GAP times the widest one: a cut inside a cluster of nearly
-   * simultaneous switches leaves out a member whose predicted time may be off by more than
-   * the gap, and the plan solve fails (stick-slip chain, n = 128: four masses within 2.5 us,
-   * the sub-step ended 0.5 us after the third; n = 512: a cluster of 17 within 20 us was cut
-   * into, and failed, in one sub-step after another) */
-  double widest = 0;
-  for (int r = 1; r <= n_max; r++) widest = fmax(widest, it->plan[r].t - it->plan[r - 1].t);
-  int q = n_max;
-  while (q > 1 && it->plan[q].t - it->plan[q - 1].t < CUT_GAP * widest) q--;
-  return dyadic_cut(q > 0 ? it->plan[q - 1].t : 0.0, it->plan[q].t, it->sys.T);
 }
 
 /* The active set of subsystem k just before time t: the start set or the set after its
@@ -345,7 +312,7 @@ static int coupled(fesd_integrator *it, const double *z, double t, int k, int i,
 static void remove_if_unchanged(fesd_integrator *it, int e) {
   const fesd__model *m = &it->model;
   const int a = m->th_off[it->plan[e].sys], b = m->th_off[it->plan[e].sys + 1];
-  if (!memcmp(after(it, e) + a, set_before_switch(it, e) + a, (size_t)(b - a))) remove_switch(it, e);
+  if (!memcmp(after(it, e) + a, set_before_switch(it, e) + a, (size_t)(b - a))) fesd__plan_remove(it, e);
 }
 
 static int update_one(fesd_integrator *it, const double *z, const fesd__violation *v, double T) {
@@ -470,52 +437,4 @@ int fesd__plan_update(fesd_integrator *it, const double *z, const fesd__violatio
     if (w->fresh && w->t > t_new + 1e-9 * T) w->lo = fmin(w->lo, t_new), w->hi = T;
   }
   return changed;
-}
-
-unsigned long fesd__plan_signature(fesd_integrator *it) {
-  sort_plan(it);
-  /* FNV-1a over subsystem, mode, kind and time (in units of 1e-6 T: a cycle repeats its
-   * plans up to round-off, progress moves the times) of each switch */
-  unsigned long h = 1469598103934665603ul;
-  const double unit = 1e-6 * it->sys.T;
-  for (int e = 0; e < it->n_plan; e++) {
-    const unsigned long w[4] = {(unsigned long)it->plan[e].sys, (unsigned long)it->plan[e].mode,
-                                (unsigned long)it->plan[e].exit, (unsigned long)lround(it->plan[e].t / unit)};
-    for (int i = 0; i < 4; i++) h = (h ^ w[i]) * 1099511628211ul;
-  }
-  return h ^ (unsigned long)it->n_plan;
-}
-
-int fesd__plan_subsystems(const fesd_integrator *it) {
-  int count = 0;
-  for (int e = 0; e < it->n_plan; e++) {
-    int seen = 0;
-    for (int q = 0; q < e && !seen; q++) seen = it->plan[q].sys == it->plan[e].sys;
-    count += !seen;
-  }
-  return count;
-}
-
-int fesd__plan_retreat(fesd_integrator *it) {
-  int nf = 0;
-  for (int e = 0; e < it->n_plan; e++) nf += it->plan[e].fresh;
-  if (nf < 2) return 0;
-  sort_plan(it);
-  /* keep the earlier half of the fresh switches (at least one) */
-  int keep = nf / 2, seen = 0;
-  for (int e = 0; e < it->n_plan; e++)
-    if (it->plan[e].fresh && seen++ >= keep) it->plan[e].fresh = 2;
-  for (int e = it->n_plan - 1; e >= 0; e--)
-    if (it->plan[e].fresh == 2) remove_switch(it, e);
-  return 1;
-}
-
-double fesd__plan_cut_after_fresh(fesd_integrator *it) {
-  sort_plan(it);
-  for (int e = 0; e < it->n_plan; e++)
-    if (it->plan[e].fresh) {
-      const double next = e + 1 < it->n_plan ? it->plan[e + 1].t : it->sys.T;
-      return dyadic_cut(it->plan[e].t, next, it->sys.T);
-    }
-  return it->sys.T;
 }

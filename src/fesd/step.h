@@ -78,6 +78,9 @@ int fesd__resort_guess(fesd_integrator *it, const double *zsrc, double T, const 
 /* ---- plan.c ---- */
 /* Forget the plan (a step without switches). */
 void fesd__plan_reset(fesd_integrator *it);
+/* The plan sorted by time; switch e removed (plan.c). */
+void fesd__plan_sort(fesd_integrator *it);
+void fesd__plan_remove(fesd_integrator *it, int e);
 /* Element layout of the plan for a (sub)step of length T: boundaries, element count (a level of
  * the ladder), per-stage active sets, boundary rows and element lengths (written into z).
  * FESD_ERR_TOO_MANY_SWITCHES when the plan needs more than max_elements. */
