@@ -100,7 +100,9 @@ typedef struct {
   double tol;            /**< ||F||_inf convergence tolerance, [1e-16, 1e-1] (default 1e-12) */
   int max_iter;          /**< Newton/LM iterations per sigma stage, [1, 1000] (default 50) */
   fesd_ncp_backend backend; /**< a fesd_ncp_backend value (default AUTO) */
-  int dense_max_n;       /**< AUTO uses the dense backend up to this n, [0, 5000] (default FESD_NCP_DENSE_MAX_N) */
+  int dense_max_n;       /**< AUTO uses the dense backend up to this n, [0, 5000] (default FESD_NCP_DENSE_MAX_N); a
+                              system with a border (the integrator's step systems) up to 2 dense_max_n
+                              takes a dense LU with the border eliminated last, reported as dense */
   double armijo;         /**< Armijo constant c1, (0, 0.5) (default 1e-4) */
   double backtrack;      /**< step reduction factor, (0, 1) (default 0.5) */
   int max_backtracks;    /**< line-search trials per direction, [1, 100] (default 30; a Newton direction gets at most 10 before the fallback) */

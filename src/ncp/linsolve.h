@@ -53,6 +53,10 @@ int fesd__ls_cholmod_create(fesd__ls **ls, int n);
  * the flags (assembled rows, columns) are read at each analyze and must stay valid. */
 int fesd__ls_border_create(fesd__ls **ls, int n, int nb);
 void fesd__ls_border_flags(fesd__ls *ls, const unsigned char *row_border, const unsigned char *col_border);
+/* Bordered dense LU (ls_bdense.c) of small systems with a border, patterns of up to max_nz
+ * entries; the flags as for the bordered KLU. */
+int fesd__ls_bdense_create(fesd__ls **ls, int n, int max_nz);
+void fesd__ls_bdense_flags(fesd__ls *ls, const unsigned char *row_border, const unsigned char *col_border);
 
 static inline void fesd__ls_destroy(fesd__ls **ls) {
   if (ls && *ls) {

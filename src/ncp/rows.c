@@ -188,11 +188,13 @@ int fesd__ncp_apply_rows(fesd_ncp *ws) {
     ws->active = ws->lu;
     ws->border_dirty = 0;
     if (ws->nb > 0 && ws->lu->backend == FESD_NCP_BACKEND_KLU && border_rows(ws) == ws->nb) {
+      const int small = ws->set.backend == FESD_NCP_BACKEND_AUTO && n <= 2 * ws->set.dense_max_n;
       if (!ws->border) {
-        int rc = fesd__ls_border_create(&ws->border, n, ws->nb);
+        int rc = small ? fesd__ls_bdense_create(&ws->border, n, ws->nnz) : fesd__ls_border_create(&ws->border, n, ws->nb);
         if (rc != FESD_OK) return rc;
       }
-      fesd__ls_border_flags(ws->border, ws->row_border, ws->col_border);
+      if (small) fesd__ls_bdense_flags(ws->border, ws->row_border, ws->col_border);
+      else fesd__ls_border_flags(ws->border, ws->row_border, ws->col_border);
       ws->active = ws->border;
     }
   } else {

@@ -2,10 +2,12 @@
  * interposed by this program and counted while fesd_set_state and fesd_step run (after
  * fesd_create, where everything is allocated).
  *  - dense backend: full integrations with crossings, sliding entry and exit: 0 allocations;
- *  - KLU (the automatic choice above n = 50): ordinary steps with an unchanged row pattern
+ *  - KLU (chosen; AUTO takes it above n = 50 without a border): ordinary steps with an unchanged row pattern
  *    allocate nothing; a step that brings a row pattern the solver has not seen (a switch
  *    step, and the first step after it) analyses it, which allocates by design (docs/ncp.md);
- *    the analyses are cached, so a second integration on the same integrator allocates nothing.
+ *    the analyses are cached, so a second integration on the same integrator allocates nothing;
+ *  - AUTO: bordered step systems up to 2 dense_max_n unknowns use a dense LU (ls_bdense.c):
+ *    a second integration allocates nothing either.
  * Skipped (exit 77) under AddressSanitizer, which owns malloc itself. */
 #include <stdio.h>
 #include <stdlib.h>
@@ -57,7 +59,7 @@ int main(void) {
     fails += !ok;
     printf("%-14s dense backend, Radau s=3, 20 steps: %ld allocations %s\n", probs[p], a, ok ? "ok" : "FAIL");
   }
-  /* KLU: Radau s = 5 on the oscillator (n = 76 > 50: the automatic choice) */
+  /* KLU: Radau s = 5 on the oscillator (n = 76) */
   long per[20];
   long a = count_run("oscillator", FESD_NCP_BACKEND_KLU, 5, 20, 1, per);
   int changes = 0; /* steps 0, 1: first analysis and first refactorization */
@@ -66,14 +68,18 @@ int main(void) {
   fails += !ok;
   printf("oscillator     KLU backend, Radau s=5, 20 steps: %ld allocations in %d of steps 2..19 "
          "(row-pattern changes at the switch) %s\n", a, changes, ok ? "ok" : "FAIL");
-  /* KLU, second integration: every pattern is in the solver's cache */
-  for (int p = 0; p < 5; p++) {
-    a = count_run(probs[p], FESD_NCP_BACKEND_KLU, 5, 20, 2, NULL);
-    ok = a == 0;
-    fails += !ok;
-    printf("%-14s KLU backend, Radau s=5, 20 steps, second integration: %ld allocations %s\n", probs[p], a,
-           ok ? "ok" : "FAIL");
-  }
+  /* second integration, KLU: every pattern is in the solver's cache; AUTO: the step systems of
+   * Radau s = 5 with a border (n <= 2 dense_max_n) take the bordered dense LU, whose arrays are
+   * made with the first selection */
+  const fesd_ncp_backend second[] = {FESD_NCP_BACKEND_KLU, FESD_NCP_BACKEND_AUTO};
+  for (int b = 0; b < 2; b++)
+    for (int p = 0; p < 5; p++) {
+      a = count_run(probs[p], second[b], 5, 20, 2, NULL);
+      ok = a == 0;
+      fails += !ok;
+      printf("%-14s %s backend, Radau s=5, 20 steps, second integration: %ld allocations %s\n", probs[p],
+             fesd_ncp_backend_name(second[b]), a, ok ? "ok" : "FAIL");
+    }
   printf("%d failures\n", fails);
   return fails != 0;
 }
