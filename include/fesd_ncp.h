@@ -102,7 +102,8 @@ typedef struct {
   fesd_ncp_backend backend; /**< a fesd_ncp_backend value (default AUTO) */
   int dense_max_n;       /**< AUTO uses the dense backend up to this n, [0, 5000] (default FESD_NCP_DENSE_MAX_N); a
                               system with a border (the integrator's step systems) up to 2 dense_max_n
-                              takes a dense LU with the border eliminated last, reported as dense */
+                              (and FESD_NCP_BDENSE_MAX_N) takes a dense LU with the border eliminated
+                              last, reported as dense */
   double armijo;         /**< Armijo constant c1, (0, 0.5) (default 1e-4) */
   double backtrack;      /**< step reduction factor, (0, 1) (default 0.5) */
   int max_backtracks;    /**< line-search trials per direction, [1, 100] (default 30; a Newton direction gets at most 10 before the fallback) */
@@ -126,6 +127,9 @@ typedef struct {
  *  the FESD reference problems, docs/ncp.md: KLU is faster above ~50 unknowns at FESD's
  *  10-20 % Jacobian density). */
 #define FESD_NCP_DENSE_MAX_N 50
+/** Largest bordered system the AUTO backend factorizes densely (see dense_max_n; measured
+ *  cheaper than KLU at 60-80 unknowns). */
+#define FESD_NCP_BDENSE_MAX_N 200
 /** Entries kept in fesd_ncp_info.residual_history. */
 #define FESD_NCP_HISTORY 64
 

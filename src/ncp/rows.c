@@ -188,7 +188,10 @@ int fesd__ncp_apply_rows(fesd_ncp *ws) {
     ws->active = ws->lu;
     ws->border_dirty = 0;
     if (ws->nb > 0 && ws->lu->backend == FESD_NCP_BACKEND_KLU && border_rows(ws) == ws->nb) {
-      const int small = ws->set.backend == FESD_NCP_BACKEND_AUTO && n <= 2 * ws->set.dense_max_n;
+      /* the crossover was measured at 60-80 unknowns (oscillator switch steps); the cap keeps a
+       * raised dense_max_n from giving n^2 arrays far beyond that (10,000 unknowns: 800 MB) */
+      const int small = ws->set.backend == FESD_NCP_BACKEND_AUTO && n <= 2 * ws->set.dense_max_n &&
+                        n <= FESD_NCP_BDENSE_MAX_N;
       if (!ws->border) {
         int rc = small ? fesd__ls_bdense_create(&ws->border, n, ws->nnz) : fesd__ls_border_create(&ws->border, n, ws->nb);
         if (rc != FESD_OK) return rc;
