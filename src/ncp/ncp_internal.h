@@ -80,7 +80,9 @@ static inline int fesd__ncp_note(fesd_ncp *ws, int rc) {
 }
 
 /* rows.c */
-int fesd__ncp_apply_rows(fesd_ncp *ws);
+/* Apply the selection (eq_on, pair_mode); keep_pattern: it has the pattern of the applied one
+ * (only A <-> B flips), whose maps and analysis stay. */
+int fesd__ncp_apply_rows(fesd_ncp *ws, int keep_pattern);
 /* Apply a pending selection (FESD_OK when ready, FESD_ERR_NOT_READY after a failed one). */
 int fesd__ncp_ensure_rows(fesd_ncp *ws);
 /* Build and analyse the pattern of the applied selection before its first Jacobian is

@@ -92,7 +92,7 @@ static int border_rows(fesd_ncp *ws) {
 int fesd__ncp_ensure_rows(fesd_ncp *ws) {
   if (ws->rows_pending) {
     ws->rows_pending = 0;
-    return fesd__ncp_apply_rows(ws);
+    return fesd__ncp_apply_rows(ws, 0);
   }
   return ws->ready ? FESD_OK : FESD_ERR_NOT_READY;
 }
@@ -145,7 +145,7 @@ int fesd__ncp_ensure_pattern(fesd_ncp *ws) {
   return rc;
 }
 
-int fesd__ncp_apply_rows(fesd_ncp *ws) {
+int fesd__ncp_apply_rows(fesd_ncp *ws, int keep_pattern) {
   const int n = ws->n, n_eq = ws->n_eq, np = ws->n_pair;
   int *eq_pos = ws->work; /* scratch, consumed before build_csc reuses work */
   int i = 0;
@@ -210,6 +210,10 @@ int fesd__ncp_apply_rows(fesd_ncp *ws) {
 
   /* deferred: the pattern and its analysis wait for the first Jacobian (a solve that starts
    * converged, and the residual, need only the row order) */
+  if (keep_pattern) { /* pattern_pending stays as it was */
+    ws->ready = 1;
+    return FESD_OK;
+  }
   ws->pattern_pending = ws->defer;
   int rc = ws->defer ? FESD_OK : apply_pattern(ws, eq_pos);
   ws->ready = rc == FESD_OK;

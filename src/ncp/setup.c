@@ -217,11 +217,22 @@ int fesd_ncp_set_rows(fesd_ncp *ws, const unsigned char *eq_active,
   }
   if (m < ws->n) return FESD_ERR_DIMENSION; /* the previous selection stays in force */
   if (same && !ws->border_dirty) return FESD_OK;
+  /* A and B assemble the same row with the same entries (rows.c, assembled_row): a selection
+   * that only flips pairs between them (an active-set change of the integrator) keeps the
+   * pattern, its maps and the solver's analysis (measured: 93 of 113 selections of the
+   * stick-slip chain, n = 128; rebuilding them cost 7.5 % of its instructions). */
+  int keep = ws->ready && !ws->rows_pending && !ws->border_dirty;
+  for (int e = 0; e < ws->n_eq && keep; e++) keep = (eq_active ? (eq_active[e] != 0) : 1) == ws->eq_on[e];
+  for (int k = 0; k < ws->n_pair && keep; k++) {
+    const unsigned char md = pair_mode ? pair_mode[k] : FESD_NCP_PAIR_FB, old = ws->pair_mode[k];
+    const int ab = (md == FESD_NCP_PAIR_A || md == FESD_NCP_PAIR_B) && (old == FESD_NCP_PAIR_A || old == FESD_NCP_PAIR_B);
+    keep = md == old || (ab && (!ws->nb || ws->raw_border[ws->n_eq + k] == ws->raw_border[ws->n_eq + ws->n_pair + k]));
+  }
   ws->rows_pending = 0;
   for (int e = 0; e < ws->n_eq; e++) ws->eq_on[e] = eq_active ? (eq_active[e] != 0) : 1;
   for (int k = 0; k < ws->n_pair; k++)
     ws->pair_mode[k] = pair_mode ? pair_mode[k] : FESD_NCP_PAIR_FB;
-  return fesd__ncp_apply_rows(ws);
+  return fesd__ncp_apply_rows(ws, keep);
 }
 
 int fesd_ncp_set_bounds(fesd_ncp *ws, const double *lb, const double *ub) {
