@@ -13,7 +13,9 @@
  * Asserted: FESD (Radau IIA s = 2..4, N_FE = 2) completes every run of the grid N_sim =
  * 100, 120, .., 1600; for N_sim >= 400 (s = 2: >= 600, see main) the 34 events (17 exits,
  * 17 entries) come in the reference's kind and order, and the event-time and end-state
- * errors converge with order >= 2s - 1.5 (least-squares slopes over the aligned runs). */
+ * errors converge with order >= 2s - 1.5 (least-squares slopes over the aligned runs).
+ * And error-controlled (fesd_integrate, Radau IIA s = 3, rtol 1e-5, 1e-8, 1e-11, atol =
+ * 1e-3 rtol): the reference's 34 events, x(T) within 10 rtol of the largest component. */
 #include "hard_util.h"
 
 #define NY 4 /* x1, x2, x3, 1 */
@@ -310,6 +312,39 @@ int main(void) {
            "(aligned runs, errors > 3e-11): event time %.2f (%d runs), x(T) %.2f (%d runs)\n", s, runs, failed, missing,
            p_ev, nfit, p_x, nfx);
     HD_CHECK(p_ev >= 2 * s - 1.5 && p_x >= 2 * s - 1.5, "s=%d: slopes %.2f %.2f, order %d", s, p_ev, p_x, 2 * s - 1);
+  }
+  /* as a user would run it: error control (fesd_integrate, Radau IIA s = 3, atol = 1e-3 rtol):
+   * the reference's 34 events, x(T) within 10 rtol |x|_inf */
+  for (double rtol = 1e-5; rtol >= 1e-11; rtol *= 1e-3) {
+    fesd_settings set;
+    fesd_settings_default(&set);
+    set.stages = 3;
+    fesd_integrator *it;
+    int st = fesd_create(&it, &m, &set);
+    fesd_tolerances tol;
+    fesd_tolerances_default(&tol);
+    tol.rtol = rtol;
+    tol.atol = 1e-3 * rtol;
+    if (!st) st = fesd_set_tolerances(it, &tol);
+    if (!st) st = fesd_set_state(it, 0, x0, NULL);
+    fesd_integrate_info info = {0};
+    if (!st) st = fesd_integrate(it, NULL, T, &info);
+    const fesd_event *ev;
+    int ne = 0;
+    fesd_event_log(it, &ev, &ne);
+    memset(&H, 0, sizeof(H));
+    for (int e = 0; e < ne && H.n_ev < HD_MAX_EV; e++) H.ev[H.n_ev++] = ev[e];
+    fesd_get_state(it, NULL, H.x_end);
+    fesd_free(&it);
+    double terr, big = 0;
+    const int a = align(&R, &H, &terr);
+    for (int r = 0; r < 3; r++) big = fmax(big, fabs(xT[r]));
+    const double ex = hd_maxdiff(H.x_end, xT, 3) / big;
+    printf("relay feedback, fesd_integrate s=3 rtol %.0e: %s, %d steps (%d rejected), %d events%s, event times "
+           "%.1e, x(T) %.1e (relative)\n",
+           rtol, fesd_status_name(st), info.steps, info.rejected, ne, a == 0 ? " (the reference's)" : "", terr, ex);
+    HD_CHECK(st == FESD_OK && a == 0 && ex <= 10 * rtol, "fesd_integrate rtol %.0e: %s, alignment %d, x(T) %.1e", rtol,
+             fesd_status_name(st), a, ex);
   }
   printf("%d failures\n", fails);
   return fails != 0;
