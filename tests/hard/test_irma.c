@@ -204,30 +204,18 @@ int main(void) {
   }
   /* as a user would run it: fesd_integrate with a relative tolerance and a small absolute one
    * (x is 1e-2..4): the event log is the reference's, the error follows rtol */
+  static hd_run H;
   for (double rtol = 1e-4; rtol >= 1e-10; rtol *= 1e-3) {
-    fesd_settings set;
-    fesd_settings_default(&set);
-    set.stages = 3;
-    fesd_integrator *it;
-    int st = fesd_create(&it, &m, &set);
-    fesd_tolerances tol;
-    fesd_tolerances_default(&tol);
-    tol.rtol = rtol;
-    tol.atol = 1e-3 * rtol;
-    if (!st) st = fesd_set_tolerances(it, &tol);
-    if (!st) st = fesd_set_state(it, 0.0, x0, NULL);
-    fesd_integrate_info info = {0};
-    if (!st) st = fesd_integrate(it, NULL, T_END, &info);
-    const fesd_event *ev;
-    int n_ev = 0, same = 1;
-    fesd_event_log(it, &ev, &n_ev);
-    double dt = 0, x[NX], err = 0;
+    fesd_integrate_info info;
+    const int st = hd_integrate_tol(&m, 3, rtol, 0.0, x0, T_END, &H, &info), n_ev = H.n_ev;
+    const fesd_event *ev = H.ev;
+    const double *x = H.x_end;
+    int same = 1;
+    double dt = 0, err = 0;
     for (int e = 0; e < n_ev; e++) {
       same = same && e < ref.n_ev && ev[e].sys == ref.sys[e] && ev[e].kind == FESD_EVENT_CROSSING;
       if (same) dt = fmax(dt, fabs(ev[e].t - ref.t[e]));
     }
-    fesd_get_state(it, NULL, x);
-    fesd_free(&it);
     for (int i = 0; i < NX; i++) err = fmax(err, fabs(x[i] - ref.x[i]) / fabs(ref.x[i]));
     printf("  fesd_integrate Radau IIA s=3, rtol %.0e: %s, %d steps (%d rejected), %d events%s, x(T) error %.2e "
            "(relative), event times %.2e\n",

@@ -316,26 +316,8 @@ int main(void) {
   /* as a user would run it: error control (fesd_integrate, Radau IIA s = 3, atol = 1e-3 rtol):
    * the reference's 34 events, x(T) within 10 rtol |x|_inf */
   for (double rtol = 1e-5; rtol >= 1e-11; rtol *= 1e-3) {
-    fesd_settings set;
-    fesd_settings_default(&set);
-    set.stages = 3;
-    fesd_integrator *it;
-    int st = fesd_create(&it, &m, &set);
-    fesd_tolerances tol;
-    fesd_tolerances_default(&tol);
-    tol.rtol = rtol;
-    tol.atol = 1e-3 * rtol;
-    if (!st) st = fesd_set_tolerances(it, &tol);
-    if (!st) st = fesd_set_state(it, 0, x0, NULL);
-    fesd_integrate_info info = {0};
-    if (!st) st = fesd_integrate(it, NULL, T, &info);
-    const fesd_event *ev;
-    int ne = 0;
-    fesd_event_log(it, &ev, &ne);
-    memset(&H, 0, sizeof(H));
-    for (int e = 0; e < ne && H.n_ev < HD_MAX_EV; e++) H.ev[H.n_ev++] = ev[e];
-    fesd_get_state(it, NULL, H.x_end);
-    fesd_free(&it);
+    fesd_integrate_info info;
+    const int st = hd_integrate_tol(&m, 3, rtol, 0, x0, T, &H, &info), ne = H.n_ev;
     double terr, big = 0;
     const int a = align(&R, &H, &terr);
     for (int r = 0; r < 3; r++) big = fmax(big, fabs(xT[r]));
