@@ -250,13 +250,8 @@ void fesd__stage_theta(fesd_integrator *it, const fesd__point_eval *pe, const un
   }
   int ns = 0, pi[SLIDE_DIRECT_MAX], pj[SLIDE_DIRECT_MAX];
   for (int k = 0; k < m->nsys; k++) {
-    int cnt = 0, i = -1, j = -1;
-    for (int l = m->th_off[k]; l < m->th_off[k + 1]; l++)
-      if (a[l]) {
-        if (cnt++ == 0) i = l;
-        else j = l;
-      }
-    if (cnt != 2) continue;
+    int j, i = fesd__two_modes(m, a, k, &j);
+    if (i < 0) continue;
     if (ns < SLIDE_DIRECT_MAX) pi[ns] = i, pj[ns] = j;
     ns++;
   }
@@ -269,13 +264,8 @@ void fesd__stage_theta(fesd_integrator *it, const fesd__point_eval *pe, const un
    * surface attracts */
   for (int sweep = 0; sweep < 4; sweep++)
     for (int k = 0; k < m->nsys; k++) {
-      int i = -1, j = -1, cnt = 0;
-      for (int l = m->th_off[k]; l < m->th_off[k + 1]; l++)
-        if (a[l]) {
-          if (cnt++ == 0) i = l;
-          else j = l;
-        }
-      if (cnt != 2) continue;
+      int j, i = fesd__two_modes(m, a, k, &j);
+      if (i < 0) continue;
       double ai, aj;
       fesd__normal_components(it, pe, th, ftot, i, j, &ai, &aj);
       if (ai > 0 && aj < 0) { /* a sliding mode at this point */

@@ -300,3 +300,14 @@ void fesd__point_free(fesd__point_eval *pe) {
   free(pe->g);
   memset(pe, 0, sizeof(*pe));
 }
+
+int fesd__two_modes(const fesd__model *m, const unsigned char *a, int k, int *j) {
+  int i = -1, cnt = 0;
+  *j = -1;
+  for (int l = m->th_off[k]; l < m->th_off[k + 1]; l++)
+    if (a[l]) {
+      if (cnt++ == 0) i = l;
+      else *j = l;
+    }
+  return cnt == 2 ? i : -1;
+}

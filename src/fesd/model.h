@@ -65,6 +65,9 @@ int fesd__model_fields_active(fesd__model *m, double t, const double *x, const d
 int fesd__model_g(fesd__model *m, double t, const double *x, const double *u, double *g);
 
 /* y += a f_i (y dense, nx) */
+/* The two active modes (flags a, one per stacked mode) of subsystem k: returns the first and
+ * writes the second to *j when exactly two are active (a 2-mode sliding mode), else -1. */
+int fesd__two_modes(const fesd__model *m, const unsigned char *a, int k, int *j);
 void fesd__F_axpy(const fesd__model *m, const fesd__point_eval *pe, int i, double a, double *y);
 /* grad g_i . v (v dense, nx) */
 double fesd__dg_dot(const fesd__model *m, const fesd__point_eval *pe, int i, const double *v);

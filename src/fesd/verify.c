@@ -254,18 +254,6 @@ static int filippov(fesd_integrator *it, const fesd__point_eval *pe, const doubl
   return bad_i ? i : bad_j ? j : -2;
 }
 
-/* The two active modes of subsystem k in act (or -1). */
-static int two_modes(const fesd_integrator *it, const unsigned char *a, int k, int *j) {
-  int i = -1, cnt = 0;
-  *j = -1;
-  for (int l = it->model.th_off[k]; l < it->model.th_off[k + 1]; l++)
-    if (a[l]) {
-      if (cnt++ == 0) i = l;
-      else *j = l;
-    }
-  return cnt == 2 ? i : -1;
-}
-
 /* With several subsystems sliding at one point (a co-dimension-2 sliding mode of a Cartesian
  * product), subsystem k's own test holds the others' multipliers fixed, but they change with
  * k's mode: the sliding mode stands if neither of k's modes, alone and with the other sliding
@@ -278,7 +266,7 @@ static int alternative_exists(fesd_integrator *it, const fesd__point_eval *pe, c
   int coupled = 0;
   for (int l = 0; l < m->nsys && !coupled; l++) {
     int jl;
-    coupled = l != k && two_modes(it, a, l, &jl) >= 0;
+    coupled = l != k && fesd__two_modes(&it->model, a, l, &jl) >= 0;
   }
   if (!coupled) return 1; /* a single sliding subsystem: its own test decides */
   double *keep = it->ftot + 2 * nx, *f2 = it->ftot + nx, *th2 = it->fil_th;
@@ -297,7 +285,7 @@ static int alternative_exists(fesd_integrator *it, const fesd__point_eval *pe, c
      * of p (dp, in the units of fesd__normal_components / filippov) */
     int ok = dp <= FIL_STAGE_TOL * (fabs(dp) + fabs(dq));
     for (int l = 0; l < m->nsys && ok; l++) {
-      int jl, il = two_modes(it, a2, l, &jl);
+      int jl, il = fesd__two_modes(&it->model, a2, l, &jl);
       if (il >= 0) ok = filippov(it, pe, th2, f2, il, jl, FIL_STAGE_TOL) == -2;
     }
     found = ok;
@@ -320,7 +308,7 @@ static int scan_filippov(fesd_integrator *it, const double *z, const unsigned ch
     int any = 0;
     for (int k = 0; k < m->nsys && !any; k++) {
       int j;
-      any = two_modes(it, a, k, &j) >= 0;
+      any = fesd__two_modes(&it->model, a, k, &j) >= 0;
     }
     if (any) {
       for (int q = 0; q < s; q++) {
@@ -337,7 +325,7 @@ static int scan_filippov(fesd_integrator *it, const double *z, const unsigned ch
         const double *th = z + fesd__th(S, n, q);
         fesd__total_field(it, &pe, th, it->ftot);
         for (int k = 0; k < m->nsys; k++) {
-          int j, i = two_modes(it, a, k, &j);
+          int j, i = fesd__two_modes(&it->model, a, k, &j);
           if (i < 0) continue;
           /* the element end where k's set changes is the switch point itself (a sliding exit:
            * the remaining field is tangent there) */
@@ -370,7 +358,7 @@ static int scan_interior(fesd_integrator *it, const double *z, const unsigned ch
     int sliding = 0;
     for (int k = 0; k < m->nsys && !sliding; k++) {
       int j;
-      sliding = two_modes(it, a, k, &j) >= 0;
+      sliding = fesd__two_modes(&it->model, a, k, &j) >= 0;
     }
     for (int p = 0; p < it->n_mid; p++) {
       fesd__poly_state(it, z, n, it->mid_w + p * FESD_RK_MAX_STAGES, x);
@@ -393,7 +381,7 @@ static int scan_interior(fesd_integrator *it, const double *z, const unsigned ch
           note(&ps[k], &v);
           continue;
         }
-        int j, i = two_modes(it, a, k, &j);
+        int j, i = fesd__two_modes(&it->model, a, k, &j);
         if (i < 0 || !sliding) continue;
         int c = filippov(it, &q, th, it->ftot, i, j, FIL_MID_TOL);
         if (c == -2 || !alternative_exists(it, &q, a, k, i, j)) continue;
