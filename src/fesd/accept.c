@@ -204,14 +204,38 @@ static int element_modes(const fesd_integrator *it, const double *z, int n, int 
   return c;
 }
 
-/* Free room of the event pool for one more event (before and after lists of up to
- * ev_span ints), or NULL when the step has no room left. The used part ends after the last
- * event's lists, so a sub-step restored by fesd__load frees its events' lists too. */
+/* Room for need events (doubling; at acceptance, outside the Newton loop: a step with more
+ * switches than any before). A step records at most nsys events per element boundary and at
+ * its end, and a large scene can switch thousands of times in one step (stick-slip chain,
+ * n = 1024: 300+ in one step), so the store grows rather than caps. The events' mode lists
+ * point into the pool: they move with it. */
+static int grow_events(fesd_integrator *it, int need) {
+  if (need <= it->ev_max) return FESD_OK;
+  int cap = it->ev_max;
+  while (cap < need) cap *= 2;
+  fesd_event *e = realloc(it->events, (size_t)cap * sizeof *e);
+  if (!e) return FESD_ERR_NOMEM;
+  it->events = e;
+  int *pool = malloc((size_t)cap * (size_t)it->ev_span * sizeof(int));
+  if (!pool) return FESD_ERR_NOMEM;
+  const size_t used = it->n_events ? (size_t)(e[it->n_events - 1].after + e[it->n_events - 1].n_after - it->ev_pool) : 0;
+  memcpy(pool, it->ev_pool, used * sizeof(int));
+  for (int i = 0; i < it->n_events; i++) {
+    e[i].before = pool + (e[i].before - it->ev_pool);
+    e[i].after = pool + (e[i].after - it->ev_pool);
+  }
+  free(it->ev_pool);
+  it->ev_pool = pool;
+  it->ev_max = cap;
+  return FESD_OK;
+}
+
+/* Free room of the event pool for one more event (before and after lists of up to ev_span
+ * ints; fesd__accept has grown the store for the step's boundaries). The used part ends after
+ * the last event's lists, so a sub-step restored by fesd__load frees its events' lists too. */
 static int *event_room(fesd_integrator *it) {
-  if (it->n_events >= FESD_MAX_EVENTS_PER_STEP) return NULL;
   const fesd_event *last = it->n_events ? &it->events[it->n_events - 1] : NULL;
-  const size_t used = last ? (size_t)(last->after + last->n_after - it->ev_pool) : 0;
-  return used + (size_t)it->ev_span <= it->ev_cap ? it->ev_pool + used : NULL;
+  return it->ev_pool + (last ? (last->after - it->ev_pool) + last->n_after : 0);
 }
 
 /* a (na entries) is a subset of b (nb); both ascending */
@@ -270,7 +294,8 @@ int fesd__accept(fesd_integrator *it, const double *z, const double *u, double T
   fesd__system *S = &it->sys;
   const int N = S->N, s = S->s, nx = it->nx, nth = it->nth, nsys = it->nsys;
   int st;
-  if ((st = fesd__grow_records(it, it->n_el + N))) return st;
+  if ((st = fesd__grow_records(it, it->n_el + N)) || (st = grow_events(it, it->n_events + (N + 1) * nsys)))
+    return st;
   fesd__system_update_refs(S); /* the sizes of the last weighting: at z (step.c, solve) */
   if (it->set.sensitivities && (st = chain_sensitivities(it, z))) return st;
   /* records */
@@ -289,7 +314,7 @@ int fesd__accept(fesd_integrator *it, const double *z, const double *u, double T
     /* events at the left boundary of element n */
     for (int k = 0; k < nsys; k++) {
       int *b = event_room(it);
-      if (!b || (n == 0 && !it->have_prev_theta)) continue;
+      if (n == 0 && !it->have_prev_theta) continue;
       int nb = n == 0 ? active_modes(it, it->theta_prev, k, b) : element_modes(it, z, n - 1, k, b);
       add_event(it, t, k, b, nb, element_modes(it, z, n, k, b + nb));
     }
@@ -300,7 +325,6 @@ int fesd__accept(fesd_integrator *it, const double *z, const double *u, double T
    * boundary comparison sees the change */
   for (int k = 0; k < nsys; k++) {
     int *b = event_room(it);
-    if (!b) continue;
     int nb = element_modes(it, z, N - 1, k, b);
     add_event(it, it->t + T, k, b, nb, active_modes(it, z + fesd__th(S, N - 1, s - 1), k, b + nb));
   }

@@ -81,7 +81,7 @@ void fesd_free(fesd_integrator **itp) {
   }
   void *other[] = {it->eq_active, it->pair_mode, it->pt_src, it->kb,   it->sw_at,    it->act,
                    it->act0,      it->cand,      it->swap_set, it->bmode, it->exit_mode, it->jump_in,
-                   it->jump_out,  it->scan_buf,  it->plan,   it->plan_after, it->bseg, it->ev_pool, it->raw_border, it->col_border,
+                   it->jump_out,  it->scan_buf,  it->plan,   it->plan_after, it->bseg, it->events, it->ev_pool, it->raw_border, it->col_border,
                    it->gn, it->gn_key, it->gn_piv, it->fil_th, it->fil_a, it->rk_act, it->rk_bmode};
   for (size_t i = 0; i < sizeof(other) / sizeof(other[0]); i++) free(other[i]);
   free(it);
@@ -285,11 +285,12 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   int max_nf = 0;
   for (int k = 0; k < it->nsys; k++) max_nf = it->model.nf[k] > max_nf ? it->model.nf[k] : max_nf;
   it->ev_span = 2 * max_nf;
-  it->ev_cap = (size_t)FESD_MAX_EVENTS_PER_STEP * (size_t)it->ev_span;
-  it->ev_pool = malloc(it->ev_cap * sizeof(int));
+  it->ev_max = FESD_EVENTS_INIT;
+  it->events = malloc((size_t)it->ev_max * sizeof(fesd_event));
+  it->ev_pool = malloc((size_t)it->ev_max * (size_t)it->ev_span * sizeof(int));
   if (fail || !it->eq_active || !it->pair_mode || !it->pt_src || !it->kb || !it->sw_at || !it->act ||
       !it->act0 || !it->cand || !it->swap_set || !it->bmode || !it->exit_mode || !it->jump_in ||
-      !it->jump_out || !it->scan_buf || !it->plan || !it->plan_after || !it->bseg || !it->ev_pool ||
+      !it->jump_out || !it->scan_buf || !it->plan || !it->plan_after || !it->bseg || !it->events || !it->ev_pool ||
       !it->raw_border || !it->col_border) {
     fesd_free(&it);
     return FESD_ERR_NOMEM;

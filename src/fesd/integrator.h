@@ -10,7 +10,7 @@
 #include "fesd_integrator.h"
 #include "fesd_ncp.h"
 
-#define FESD_MAX_EVENTS_PER_STEP 256
+#define FESD_EVENTS_INIT 64 /* initial room of the event store (grown by fesd__accept) */
 /* Plans remembered to detect a cycle of plan updates (step.c). */
 #define PLAN_SIGS 8
 /* Element counts with a solver workspace of their own (the ladder of layouts, integrator.c). */
@@ -164,12 +164,11 @@ struct fesd_integrator {
   int stop_sys;      /* the stop condition the last fesd_integrate stopped on (-1: none) */
   double stop_t;     /* ... and when (its crossing at the next step start is not logged again) */
   size_t log_pool_n, log_pool_cap;
-  fesd_event events[FESD_MAX_EVENTS_PER_STEP];
-  int n_events;
+  fesd_event *events; /* the last step's events: room for ev_max (accept.c grows it) */
+  int n_events, ev_max;
   /* active-mode lists of the events (accept.c): ev_span = 2 x the largest n_modes ints per
-   * event, ev_cap = FESD_MAX_EVENTS_PER_STEP ev_span, allocated at create */
+   * event, ev_max ev_span ints */
   int *ev_pool, ev_span;
-  size_t ev_cap;
   fesd_stats stats;
   double sum_iter_ord, sum_iter_sw;
 };
