@@ -63,6 +63,38 @@ static int run_chain(int n, double T, fesd_rk_family fam, int s, double h, chain
   return st;
 }
 
+/* The same chain error-controlled (fesd_integrate, Radau IIA s, rtol, atol = 1e-3 rtol): the
+ * events of the log; iters_sw: all Newton iterations, steps_done: accepted steps. */
+static int run_chain_tol(int n, double T, int s, double rtol, chain_run *r) {
+  fesd_friction_chain fc;
+  if (n > NMAX || fesd_friction_chain_stick_slip(&fc, n)) return -1;
+  fesd_settings set;
+  fesd_settings_default(&set);
+  set.stages = s;
+  fesd_integrator *it;
+  int st = fesd_create(&it, &fc.model, &set);
+  fesd_tolerances tol;
+  fesd_tolerances_default(&tol);
+  tol.rtol = rtol;
+  tol.atol = 1e-3 * rtol;
+  if (!st) st = fesd_set_tolerances(it, &tol);
+  if (!st) st = fesd_set_state(it, 0.0, fc.x0, NULL);
+  fesd_integrate_info info = {0};
+  if (!st) st = fesd_integrate(it, NULL, T, &info);
+  const fesd_event *ev;
+  int ne = 0;
+  fesd_event_log(it, &ev, &ne);
+  r->n_ev = 0;
+  for (int e = 0; e < ne && r->n_ev < 4096; e++) r->ev_sys[r->n_ev] = ev[e].sys, r->ev_kind[r->n_ev++] = ev[e].kind;
+  r->steps_done = info.steps;
+  r->iters = r->iters_sw = info.newton_iter;
+  fesd_get_state(it, NULL, r->x);
+  r->st = st;
+  fesd_free(&it);
+  fesd_friction_chain_free(&fc);
+  return st;
+}
+
 /* Event sequences equal up to the order of events at one time: the same multiset of
  * (subsystem, kind) (the chain's events are well separated in time, so this is the order). */
 static int same_events(const chain_run *a, const chain_run *b) {
@@ -120,6 +152,27 @@ int main(void) {
       const double p = nfit >= 2 ? hd_slope(h_fit, e_fit, nfit) : NAN;
       printf("chain n=%d s=%d: order %.2f over %d runs (method order %d)\n", n, s, p, nfit, 2 * s - 1);
       HD_CHECK(nfit < 2 || p >= 2 * s - 1 - 0.7, "n=%d s=%d: order %.2f", n, s, p);
+    }
+    /* error-controlled (Radau s = 3): the reference's events, the error within 10 tolerances,
+     * and (n = 64) no step so long that its switches multiply the Newton iterations: <= 2 per
+     * (step + event) (before the step length followed the switch rate, rtol 1e-3: 16 steps,
+     * 242 iterations for 94 events, 2.2) */
+    const double rtols[2] = {1e-3, 1e-6};
+    for (int q = 0; q < 2; q++) {
+      int st = run_chain_tol(n, T, 3, rtols[q], &A);
+      HD_CHECK(st == FESD_OK, "n=%d rtol=%g: %s", n, rtols[q], fesd_status_name(st));
+      if (st) continue;
+      double xmax = 0;
+      for (int i = 0; i < nx; i++) xmax = fmax(xmax, fabs(R.x[i]));
+      const double err = hd_maxdiff(A.x, R.x, nx), tol = rtols[q] * xmax + 1e-3 * rtols[q];
+      const double per_work = (double)A.iters / (A.steps_done + A.n_ev);
+      HD_CHECK(same_events(&A, &R), "n=%d rtol=%g: %d events, reference %d", n, rtols[q], A.n_ev, R.n_ev);
+      HD_CHECK(err <= 10 * tol, "n=%d rtol=%g: error %.2e = %.2f tolerances", n, rtols[q], err, err / tol);
+      HD_CHECK(n < 64 || per_work <= 2.0, "n=%d rtol=%g: %.2f Newton iterations per (step + event)", n, rtols[q],
+               per_work);
+      printf("chain n=%d fesd_integrate s=3 rtol=%g: err %.2e (%.3f tolerances), %d events (%s), %d steps, %d Newton "
+             "iterations (%.2f per step + event)\n", n, rtols[q], err, err / tol, A.n_ev,
+             same_events(&A, &R) ? "as the reference" : "DIFFERENT", A.steps_done, A.iters, per_work);
     }
   }
   for (int c = 0; c < 2; c++) {
