@@ -199,6 +199,10 @@ typedef struct {
   double time_other;        /**< the rest (functions, Hessian, line search bookkeeping) */
   int hessian_fallback;     /**< 1: GN_SR1 fell back to Gauss-Newton (settings.stall_window) */
   int stalled;              /**< 1: ended by the no-progress rule (status FESD_ERR_LINE_SEARCH) */
+  int stall_interval;       /**< ... and then the control interval whose switch structure
+                                 (events, or a halved step) differed between the last rejected
+                                 trial point and the iterate: where the NLP is not smooth (-1:
+                                 none seen, or not stalled) */
   int presolve_run;         /**< 1: this solve ran a presolve (settings.presolve) */
   int presolve_status;      /**< ... and its status (FESD_OK when none was run) */
   int presolve_iterations;  /**< its SQP iterations (its integrations and CPU times are included

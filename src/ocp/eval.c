@@ -42,6 +42,7 @@ int fesd__ocp_simulate(fesd_ocp *o, int k, const double *s, const double *q, dou
     memcpy(xend, o->xa, (size_t)nx * sizeof(double));
     *l = o->cost_state ? o->xa[nx] : 0.0;
     if (flags) *flags |= si.flags;
+    o->last_split = si.splits + si.substeps;
     if (sens) st = fesd_get_sensitivities(o->it, o->Sxa, o->nu > 0 ? o->Sua : NULL);
   } else {
     o->info.integrator_failures++;
@@ -49,6 +50,27 @@ int fesd__ocp_simulate(fesd_ocp *o, int k, const double *s, const double *q, dou
   (void)na;
   o->t_int += fesd__thread_cpu_time() - t0;
   return st;
+}
+
+/* The switch structure of the last step: FNV-1a over its events' subsystems, kinds and active
+ * sets (not their times) and over the integrator's halvings and sub-steps (split: a halved step
+ * is another discretisation of the interval). Two points whose interval k has different hashes
+ * lie on different pieces of Phi_k, which need not join continuously (docs/ocp.md); the
+ * verbose log and info.stall_interval name such intervals. */
+static unsigned structure_hash(const fesd_integrator *it, int split) {
+  const fesd_event *ev;
+  int n;
+  unsigned h = 2166136261u;
+  if (fesd_last_events(it, &ev, &n)) return 0;
+#define MIX(v) (h = (h ^ (unsigned)(v)) * 16777619u)
+  MIX(split);
+  for (int e = 0; e < n; e++) {
+    MIX(ev[e].sys), MIX(ev[e].kind), MIX(ev[e].n_before), MIX(ev[e].n_after);
+    for (int i = 0; i < ev[e].n_before; i++) MIX(ev[e].before[i]);
+    for (int i = 0; i < ev[e].n_after; i++) MIX(ev[e].after[i]);
+  }
+#undef MIX
+  return h;
 }
 
 /* Gauss-Newton data of interval k: the least-squares residual's Jacobian w.r.t. (x_k, q_k) at
@@ -119,6 +141,7 @@ static int evaluate(fesd_ocp *o, ocp_point *pt, int chain) {
       if (chain && st != FESD_ERR_NOMEM) chain_end(o, pt, k);
       return st;
     }
+    pt->sig[k] = structure_hash(o->it, o->last_split);
     if (chain) memcpy(w + (k + 1) * nb, pt->phi + (size_t)k * nx, (size_t)nx * sizeof(double));
     double *Sx = pt->Sx + (size_t)k * nx * nx, *Su = pt->Su + (size_t)k * nx * nu;
     for (int j = 0; j < nx; j++) memcpy(Sx + (size_t)j * nx, o->Sxa + (size_t)j * na, (size_t)nx * sizeof(double));

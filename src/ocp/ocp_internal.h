@@ -41,6 +41,9 @@ typedef struct {
   double *gn;    /* Gauss-Newton data: per interval 2 x (nL x nb) (start, end), then nM x nx */
   double viol;   /* l1 norm of the constraint violation */
   int flags;     /* integrator flags of its intervals */
+  unsigned *sig; /* N: switch structure of each interval (a hash of its events: subsystem, kind,
+                    active sets, not their times; and of the integrator's halvings and
+                    sub-steps), to name the intervals where a step changes it */
 } ocp_point;
 
 /* A QP as a mixed complementarity problem for src/ncp: raw rows = cst + sum val * z[col]. */
@@ -100,6 +103,9 @@ struct fesd_ocp {
   double *m_dyn, *m_x0, *m_xb, *m_ub, *m_path, *m_term, *m_l1;
   fesd_ocp_info info;
   fesd_ocp_info best_info;  /* KKT residuals, objective and flags of w_best */
+  int kink;                 /* the last interval whose switch structure differed between a rejected
+                               trial point and the iterate (-1: none since the last good step) */
+  int last_split;           /* halvings + sub-steps of the last interval integration */
   double t_int, t_qp;       /* accumulated CPU seconds of the current solve */
 };
 

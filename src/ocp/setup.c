@@ -112,7 +112,7 @@ static double *copy_or(int *fail, const double *src, int n, double fill) {
 }
 
 static void point_free(ocp_point *p) {
-  free(p->w), free(p->c), free(p->grad), free(p->jv), free(p->phi), free(p->Sx), free(p->Su), free(p->gn);
+  free(p->w), free(p->c), free(p->grad), free(p->jv), free(p->phi), free(p->Sx), free(p->Su), free(p->gn), free(p->sig);
 }
 
 void fesd_ocp_free(fesd_ocp **op) {
@@ -171,6 +171,7 @@ static int alloc_all(fesd_ocp *o) {
     q->jv = get(&f, (size_t)o->nnzJ, sizeof(double)), q->phi = get(&f, N * nx, sizeof(double));
     q->Sx = get(&f, N * nx * nx, sizeof(double)), q->Su = get(&f, N * nx * nu, sizeof(double));
     q->gn = get(&f, N * 2 * nL * nb + nM * nx, sizeof(double));
+    q->sig = get(&f, N, sizeof(unsigned));
   }
   o->y = get(&f, m, sizeof(double)), o->yq = get(&f, m, sizeof(double)), o->yq2 = get(&f, m, sizeof(double));
   o->d = get(&f, nw, sizeof(double)), o->dsoc = get(&f, nw, sizeof(double)), o->gl = get(&f, nw, sizeof(double)), o->gl2 = get(&f, nw, sizeof(double));

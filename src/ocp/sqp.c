@@ -99,6 +99,22 @@ static int qp_step(fesd_ocp *o, double *nu, int *elastic, double *vlin, int *inf
   return FESD_OK;
 }
 
+/* the first interval whose switch structure differs between a and b (-1: none) */
+static int first_change(const fesd_ocp *o, const ocp_point *a, const ocp_point *b) {
+  for (int k = 0; k < o->N; k++)
+    if (a->sig[k] != b->sig[k]) return k;
+  return -1;
+}
+
+/* the intervals whose switch structure differs between a and b, as text (verbose log) */
+static const char *changed(const fesd_ocp *o, const ocp_point *a, const ocp_point *b, char *buf, size_t n) {
+  size_t len = 0;
+  buf[0] = 0;
+  for (int k = 0; k < o->N && len + 8 < n; k++)
+    if (a->sig[k] != b->sig[k]) len += (size_t)snprintf(buf + len, n - len, " %d", k);
+  return len ? buf : " none";
+}
+
 static void step_to(const fesd_ocp *o, ocp_point *t, const double *d, double alpha) {
   const double *w = o->cur->w;
   for (int j = 0; j < o->nw; j++) {
@@ -175,10 +191,19 @@ static int line_search(fesd_ocp *o, double nu, int elastic, double vlin, int rel
     step_to(o, o->trial, o->d, alpha);
     int st = fesd__ocp_eval(o, o->trial);
     if (st == FESD_ERR_NOMEM) return st;
+    if (o->set.verbose) {
+      char buf[96];
+      if (st) say(o, "    alpha %.3g: %s", alpha, fesd_status_name(st));
+      else
+        say(o, "    alpha %.3g: merit %+.3e (f %+.3e, viol %.2e) vs %+.3e; structure changed in:%s", alpha,
+            o->trial->f + nu * o->trial->viol - phi0, o->trial->f - c->f, o->trial->viol, o->set.armijo * alpha * D + slack,
+            changed(o, c, o->trial, buf, sizeof(buf)));
+    }
     if (!st && o->trial->f + nu * o->trial->viol <= phi0 + o->set.armijo * alpha * D + slack) {
       *alpha_out = alpha;
       return FESD_OK;
     }
+    if (!st && first_change(o, c, o->trial) >= 0) o->kink = first_change(o, c, o->trial);
     if (!st && ls == 0 && o->set.soc && soc_step(o, elastic, nu, phi0, D, slack)) {
       swap(&o->trial, &o->spare);
       o->info.soc_steps++;
@@ -232,6 +257,8 @@ static int iterate(fesd_ocp *o, int warm) {
   int elastic = 0, reset_done = 0, st;
   fesd_ocp_hessian hess = o->set.hessian; /* GN_SR1 may fall back to GAUSS_NEWTON */
   stall_track stall = {0, INFINITY};
+  o->kink = -1;
+  o->info.stall_interval = -1;
   o->hist_n = 0;
   double prev_d = INFINITY;
   int n_full = 0;
@@ -298,10 +325,16 @@ static int iterate(fesd_ocp *o, int warm) {
     memcpy(o->y, o->yq, (size_t)m * sizeof(double));
     o->info.iterations++;
     o->info.penalty = nu;
+    if (alpha >= 0.1) o->kink = -1; /* only rejections within a run of poor steps count */
     if (stalled(o, &stall, alpha)) {
       if (hess != FESD_OCP_HESSIAN_GN_SR1) {
-        say(o, "  no progress in %d iterations: stop", o->set.stall_window);
         o->info.stalled = 1;
+        o->info.stall_interval = o->kink;
+        if (o->kink >= 0)
+          say(o, "  no progress in %d iterations: stop (trial points rejected where the switch structure of interval %d "
+                 "changes: its step map is discontinuous or kinked there)", o->set.stall_window, o->kink);
+        else
+          say(o, "  no progress in %d iterations: stop", o->set.stall_window);
         return FESD_ERR_LINE_SEARCH;
       }
       say(o, "  no progress in %d iterations: Gauss-Newton from here", o->set.stall_window);
@@ -316,6 +349,7 @@ int fesd_ocp_solve(fesd_ocp *o, fesd_ocp_info *info) {
   const double t0 = fesd__thread_cpu_time();
   const int m = o->mE + o->mI;
   memset(&o->info, 0, sizeof(o->info));
+  o->info.stall_interval = -1;
   o->t_int = o->t_qp = 0;
   int st = FESD_OK;
   o->info.presolve_status = FESD_OK;
