@@ -1,6 +1,6 @@
-/* Internal: the step strategy (step.c), the switch plan of a step (plan.c), the checks of a
- * converged step (verify.c), initial guesses (guess.c), the FB fallback's predictor
- * (predict.c), acceptance (accept.c). Row weights: system.h, weights.c. */
+/* Internal: the step strategy (step.c), standard time-stepping (step_std.c), the switch plan of
+ * a step (plan.c), the checks of a converged step (verify.c), initial guesses (guess.c), the FB
+ * fallback's predictor (predict.c), acceptance (accept.c). Row weights: system.h, weights.c. */
 #ifndef FESD_STEP_H
 #define FESD_STEP_H
 #include "fesd/integrator.h"
@@ -10,6 +10,13 @@
 int fesd__substep(fesd_integrator *it, const double *u, double T, int depth, fesd_step_info *info);
 /* lambda00 = g(x) - min g per subsystem (and d/d(x,u) into sys.lam00_dp when deriv). */
 int fesd__update_lambda00(fesd_integrator *it, const double *x, const double *u, int deriv);
+/* Shared by the solve paths (step.c, step_std.c): a callback failure, NaN/Inf or no memory (no
+ * other path can succeed); the solve with the per-stage active sets it->act from z; the solve
+ * with the start's active set everywhere from the warm start; the standard method's step. */
+int fesd__hard_failure(int st);
+int fesd__fixed_solve(fesd_integrator *it, double *z, int max_iter, int slow_iter, fesd_step_info *info);
+int fesd__start_solve(fesd_integrator *it, fesd_step_info *info);
+int fesd__std_path(fesd_integrator *it, fesd_step_info *info);
 
 /* ---- active.c ---- */
 void fesd__act_from_theta(const fesd_integrator *it, const double *theta, unsigned char *a);
