@@ -3,6 +3,7 @@
     import fesd
     model = fesd.Model(nx, [fesd.Subsystem(n_modes, fields=..., switch=...)])
     res = fesd.solve_ivp(model, (t0, tf), x0, rtol=1e-8)
+    ocp = fesd.OCP(model, n_ctrl, t0, tf, x0, lagrange_lsq=..., u_lb=..., u_ub=...); ocp.solve()
 
 See docs/python.md.
 """
@@ -23,3 +24,6 @@ from .dense import DenseSolution  # noqa: E402
 from .ivp import OdeResult, solve_ivp  # noqa: E402
 
 __all__ += ["solve_ivp", "OdeResult", "DenseSolution"]
+from .ocp import OCP, OcpInterval, OcpMultipliers, OcpResult  # noqa: E402
+
+__all__ += ["OCP", "OcpResult", "OcpMultipliers", "OcpInterval"]

@@ -5,7 +5,7 @@ A trampoline never lets an exception reach ctypes: a callable that raises or ret
 of the wrong shape makes it return 1 (the library then fails the step with FESD_ERR_CALLBACK);
 a NaN or Inf is written through (the library reports FESD_ERR_NONFINITE, or recovers by a
 shorter step). Either way the first failure since the last reset() is kept in .failure for the
-exception the caller raises.
+exception the caller raises (a raised exception replaces a non-finite value seen before it).
 
 Vectorised fields (Subsystem.fields, fields_jac) are evaluated once per point and subsystem:
 the results are kept in a small first-in-first-out cache keyed by (t, x, u), large enough for
@@ -99,6 +99,7 @@ class Bridge:
         self.nx, self.nu = model.nx, model.nu
         self.nbx, self.nbu = 8 * model.nx, 8 * model.nu
         self.failure = None
+        self.abort = False  # set by a KeyboardInterrupt / SystemExit: later calls fail at once
         self.nonfinite_seen = 0
         cap = 2 * (model.nx + model.nu) + 2
         subs = self.subs
@@ -120,14 +121,17 @@ class Bridge:
 
     # ---- bookkeeping ----
     def reset(self):
-        self.failure = None
+        self.failure, self.abort = None, False
         for c in self.fcache + self.jcache + self.scache:
             c.clear()
         self.rcache.clear()
 
     def _fail(self, role, sys, mode, t, x, exc):
-        if self.failure is None:
+        if self.failure is None or (isinstance(self.failure.exc, FloatingPointError)
+                                    and not isinstance(exc, FloatingPointError)):  # a raise beats a NaN
             self.failure = Failure(role, sys, mode, t, _frombuffer(_string_at(x, self.nbx)).copy(), exc)
+        if isinstance(exc, (KeyboardInterrupt, SystemExit)):
+            self.abort = True  # a long library call (an OCP solve) then ends soon
         return 1
 
     def _nonfinite(self, role, sys, mode, t, x):
@@ -144,6 +148,8 @@ class Bridge:
 
     # ---- fields ----
     def _field(self, sys, mode, t, x, u, f, user):
+        if self.abort:
+            return 1
         try:
             sub, nb = self.subs[sys], self.nbx
             if sub.fields is not None:
@@ -204,6 +210,8 @@ class Bridge:
 
     # ---- switching functions / indicators ----
     def _switch(self, sys, t, x, u, c, user):
+        if self.abort:
+            return 1
         try:
             sub = self.subs[sys]
             key = self._key(t, x, u)

@@ -1,6 +1,6 @@
 """ctypes view of libfesd: library lookup, the public structs and function prototypes.
 
-The struct layouts mirror include/fesd_integrator.h, fesd_ncp.h and fesd_status.h field by
+The struct layouts mirror include/fesd_integrator.h, fesd_ncp.h, fesd_ocp.h and fesd_status.h field by
 field; python/tests/test_layout.py checks them against sizeof/offsetof printed by a C
 program compiled with the headers.
 """
@@ -90,13 +90,58 @@ class Stats(ctypes.Structure):
                                 "max_iter_switch_step", "mean_iter_switch_step")]
 
 
+# ---- optimal control (fesd_ocp.h) ----
+OCP_FN = ctypes.CFUNCTYPE(c_int, c_double, _V, _V, _V, _V, _V, _V)  # (t, x, u, val, dx, du, user)
+OCP_LOG_FN = ctypes.CFUNCTYPE(None, c_void_p, c_char_p)               # (log_user, msg)
+
+
+class OcpProblem(ctypes.Structure):
+    _fields_ = [("model", ctypes.POINTER(ModelStruct)), ("n_ctrl", c_int), ("t0", c_double),
+                ("tf", c_double), ("x0", P_double), ("x0_lb", P_double), ("x0_ub", P_double),
+                ("x_lb", P_double), ("x_ub", P_double), ("u_lb", P_double), ("u_ub", P_double),
+                ("lagrange", OCP_FN), ("n_lagrange_lsq", c_int), ("lagrange_lsq", OCP_FN),
+                ("mayer", OCP_FN), ("n_mayer_lsq", c_int), ("mayer_lsq", OCP_FN),
+                ("n_l1", c_int), ("l1", OCP_FN), ("l1_weight", P_double),
+                ("n_path", c_int), ("path", OCP_FN), ("path_lb", P_double), ("path_ub", P_double),
+                ("n_term", c_int), ("terminal", OCP_FN), ("term_lb", P_double), ("term_ub", P_double),
+                ("user", c_void_p)]
+
+
+class OcpSettings(ctypes.Structure):
+    _fields_ = [("integrator", Settings), ("hessian", c_int), ("max_iter", c_int), ("tol_stat", c_double),
+                ("tol_feas", c_double), ("tol_comp", c_double), ("penalty0", c_double),
+                ("penalty_max", c_double), ("armijo", c_double), ("backtrack", c_double),
+                ("max_backtracks", c_int), ("soc", c_int), ("nonmonotone", c_int), ("reg_primal", c_double),
+                ("reg_dual", c_double), ("qp_tol", c_double), ("qp_max_iter", c_int), ("stall_window", c_int),
+                ("qp_backend", c_int), ("init", c_int), ("presolve", c_int), ("presolve_n_fe", c_int),
+                ("verbose", c_int), ("log", OCP_LOG_FN), ("log_user", c_void_p)]
+
+
+class OcpInfo(ctypes.Structure):
+    _fields_ = [(n, c_int) for n in (
+        "status", "iterations", "qp_iterations", "qp_elastic", "qp_failures", "line_search_trials", "soc_steps",
+        "hessian_updates", "hessian_skipped", "hessian_resets", "integrations", "integrator_failures",
+        "integrator_flags")] + [(n, c_double) for n in (
+        "objective", "stationarity", "stationarity_rel", "feasibility", "complementarity", "min_multiplier",
+        "penalty", "max_step", "time_total", "time_integration", "time_qp", "time_other")] + [(n, c_int) for n in (
+        "hessian_fallback", "stalled", "stall_interval", "presolve_run", "presolve_status",
+        "presolve_iterations", "presolve_used")]
+
+
+class OcpMultipliers(ctypes.Structure):
+    _fields_ = [(n, P_double) for n in ("dynamics", "x0", "x_bound", "u_bound", "path", "terminal", "l1")]
+
+
 STRUCTS = {"fesd_ncp_settings": NcpSettings, "fesd_settings": Settings, "fesd_model": ModelStruct,
            "fesd_step_info": StepInfo, "fesd_event": EventStruct, "fesd_step_data": StepData,
-           "fesd_tolerances": Tolerances, "fesd_integrate_info": IntegrateInfo, "fesd_stats": Stats}
+           "fesd_tolerances": Tolerances, "fesd_integrate_info": IntegrateInfo, "fesd_stats": Stats,
+           "fesd_ocp_problem": OcpProblem, "fesd_ocp_settings": OcpSettings, "fesd_ocp_info": OcpInfo,
+           "fesd_ocp_multipliers": OcpMultipliers}
 
 # ---- constants (fesd_status.h, fesd_rk.h, fesd_integrator.h) ----
 FESD_ROOT, FESD_OK = 1, 0
 FESD_ERR_CALLBACK, FESD_ERR_NONFINITE, FESD_ERR_TOO_MANY_STEPS = -6, -7, -19
+FESD_ERR_INVALID_ARG = -2
 FAMILIES = {"radau": 0, "gauss": 1, "lobatto3a": 2, "lobatto3c": 3, "explicit": 4}
 COLLOCATION = ("radau", "gauss", "lobatto3a")  # families with a collocation polynomial
 METHODS = {"fesd": 0, "standard": 1}
@@ -171,6 +216,16 @@ _proto("fesd_integrate_step", c_int, c_void_p, P_double, c_double, P(IntegrateIn
 _proto("fesd_integrate_grid", c_int, c_void_p, P_double, c_int, P_double, P_double, P(IntegrateInfo))
 _proto("fesd_get_stats", c_int, c_void_p, P(Stats))
 _proto("fesd_dims", c_int, c_void_p, P_int, P_int)
+_proto("fesd_ocp_settings_default", c_int, P(OcpSettings))
+_proto("fesd_ocp_create", c_int, P(c_void_p), P(OcpProblem), P(OcpSettings))
+_proto("fesd_ocp_free", None, P(c_void_p))
+_proto("fesd_ocp_set_guess", c_int, c_void_p, P_double, P_double)
+_proto("fesd_ocp_set_x0", c_int, c_void_p, P_double)
+_proto("fesd_ocp_solve", c_int, c_void_p, P(OcpInfo))
+_proto("fesd_ocp_get_solution", c_int, c_void_p, P_double, P_double)
+_proto("fesd_ocp_get_multipliers", c_int, c_void_p, P(OcpMultipliers))
+_proto("fesd_ocp_interval", c_int, c_void_p, c_int, P(StepData), P(P(EventStruct)), P_int)
+_proto("fesd_ocp_dims", c_int, c_void_p, P_int, P_int, P_int)
 
 
 def status_name(code):

@@ -51,6 +51,75 @@ def _dptr(a):
     return a.ctypes.data_as(_lib.P_double)
 
 
+def fill_settings(s, method, family, stages, n_fe, sensitivities, settings):
+    """Fill a fesd_settings struct (defaults already in it): method, family, stages, n_fe,
+    sensitivities and any other field by name (ncp_* for the solver's). Unknown names raise
+    TypeError, unknown method/family ValueError; values are checked by the library."""
+    if method not in _lib.METHODS:
+        raise ValueError(f"method must be one of {sorted(_lib.METHODS)}")
+    if family not in _lib.FAMILIES:
+        raise ValueError(f"family must be one of {sorted(_lib.FAMILIES)}")
+    s.method, s.family, s.stages, s.n_fe = _lib.METHODS[method], _lib.FAMILIES[family], stages, n_fe
+    s.sensitivities = 1 if sensitivities else 0
+    for k, v in settings.items():
+        target, name = (s.ncp, k[4:]) if k.startswith("ncp_") else (s, k)
+        if name not in dict(type(target)._fields_) or name in ("ncp", "log", "log_user"):
+            raise TypeError(f"unknown setting {k!r}")
+        setattr(target, name, v)
+    return s
+
+
+def build_model_struct(m, b, events=()):
+    """The fesd_model struct of a fesd.Model with the callbacks of its Bridge b; returns
+    (struct, keep): keep holds the arrays the struct points to (keep them alive with it)."""
+    nsys = m.nsys
+    n_modes = (ctypes.c_int * nsys)(*[s.n_modes for s in m.subsystems])
+    n_switch = (ctypes.c_int * nsys)(*[s.n_switch for s in m.subsystems])
+    keep = [n_modes, n_switch]
+    sign_ptr = None
+    if any(s.sign is not None for s in m.subsystems):
+        PB = ctypes.POINTER(ctypes.c_byte)
+        arr = (PB * nsys)()
+        for k, s in enumerate(m.subsystems):
+            if s.sign is not None:
+                buf = (ctypes.c_byte * s.sign.size)(*s.sign.ravel().tolist())
+                keep.append(buf)
+                arr[k] = ctypes.cast(buf, PB)
+        keep.append(arr)
+        sign_ptr = arr
+    ms = _lib.ModelStruct()
+    ms.nx, ms.nu, ms.nsys = m.nx, m.nu, nsys
+    ms.n_modes = ctypes.cast(n_modes, _lib.P_int)
+    ms.n_switch = ctypes.cast(n_switch, _lib.P_int)
+    if sign_ptr is not None:
+        ms.sign = ctypes.cast(sign_ptr, type(ms.sign))
+    ms.field, ms.field_jac, ms.sw, ms.sw_jac = b.c_field, b.c_field_jac, b.c_sw, b.c_sw_jac
+    ms.time_dependent = 1 if m.time_dependent else 0
+    ms.drift, ms.drift_jac = b.c_drift, b.c_drift_jac
+    if events:
+        dirs = (ctypes.c_int * len(events))(*[event_direction(e) for e in events])
+        keep.append(dirs)
+        ms.n_roots, ms.roots, ms.root_dir = len(events), b.c_roots, ctypes.cast(dirs, _lib.P_int)
+    return ms, keep
+
+
+def step_data(d, model, n_extra=0):
+    """Copies of a fesd_step_data's arrays for a fesd.Model: (h, t, x, theta, lambda_, mu) with
+    x's first model.nx + n_extra internal states (n_extra = 1: the OCP's cost state), theta and
+    lambda_ of the user's modes, mu of the user's subsystems."""
+    n, s, nth = d.n_elements, d.stages, d.n_theta
+    nsys_int = d.n_sys  # stride of mu: the user's subsystems first, then the drift / clock / stops
+    n_user = sum(sub.n_modes for sub in model.subsystems)
+
+    def arr(p, size):
+        return np.ctypeslib.as_array(p, shape=(size,)).copy() if size > 0 and p else np.zeros(0)
+    x = arr(d.x, (n + 1) * d.nx).reshape(n + 1, d.nx)[:, : model.nx + n_extra]
+    th = arr(d.theta, n * s * nth).reshape(n, s, nth)[:, :, :n_user]
+    la = arr(d.lambda_, n * s * nth).reshape(n, s, nth)[:, :, :n_user]
+    mu = arr(d.mu, n * s * nsys_int).reshape(n, s, nsys_int)[:, :, : model.nsys]
+    return arr(d.h, n), arr(d.t, n + 1), x, th, la, mu
+
+
 class Integrator:
     """A FESD (or standard time-stepping) integrator for a fesd.Model.
 
@@ -76,17 +145,7 @@ class Integrator:
         self.bridge = Bridge(model, self.events)
         s = _lib.Settings()
         _lib.lib.fesd_settings_default(_byref(s))
-        if method not in _lib.METHODS:
-            raise ValueError(f"method must be one of {sorted(_lib.METHODS)}")
-        if family not in _lib.FAMILIES:
-            raise ValueError(f"family must be one of {sorted(_lib.FAMILIES)}")
-        s.method, s.family, s.stages, s.n_fe = _lib.METHODS[method], _lib.FAMILIES[family], stages, n_fe
-        s.sensitivities = 1 if sensitivities else 0
-        for k, v in settings.items():
-            target, name = (s.ncp, k[4:]) if k.startswith("ncp_") else (s, k)
-            if name not in dict(type(target)._fields_) or name in ("ncp", "log", "log_user"):
-                raise TypeError(f"unknown setting {k!r}")
-            setattr(target, name, v)
+        fill_settings(s, method, family, stages, n_fe, sensitivities, settings)
         self.settings = s
         self.method, self.family, self.stages, self.n_fe = method, family, stages, n_fe
         self.sensitivities_on = bool(sensitivities)
@@ -101,36 +160,7 @@ class Integrator:
         self._iinfo = _lib.IntegrateInfo()
 
     def _build_model(self):
-        m, b = self.model, self.bridge
-        nsys = m.nsys
-        n_modes = (ctypes.c_int * nsys)(*[s.n_modes for s in m.subsystems])
-        n_switch = (ctypes.c_int * nsys)(*[s.n_switch for s in m.subsystems])
-        keep = [n_modes, n_switch]
-        sign_ptr = None
-        if any(s.sign is not None for s in m.subsystems):
-            PB = ctypes.POINTER(ctypes.c_byte)
-            arr = (PB * nsys)()
-            for k, s in enumerate(m.subsystems):
-                if s.sign is not None:
-                    buf = (ctypes.c_byte * s.sign.size)(*s.sign.ravel().tolist())
-                    keep.append(buf)
-                    arr[k] = ctypes.cast(buf, PB)
-            keep.append(arr)
-            sign_ptr = arr
-        ms = _lib.ModelStruct()
-        ms.nx, ms.nu, ms.nsys = m.nx, m.nu, nsys
-        ms.n_modes = ctypes.cast(n_modes, _lib.P_int)
-        ms.n_switch = ctypes.cast(n_switch, _lib.P_int)
-        if sign_ptr is not None:
-            ms.sign = ctypes.cast(sign_ptr, type(ms.sign))
-        ms.field, ms.field_jac, ms.sw, ms.sw_jac = b.c_field, b.c_field_jac, b.c_sw, b.c_sw_jac
-        ms.time_dependent = 1 if m.time_dependent else 0
-        ms.drift, ms.drift_jac = b.c_drift, b.c_drift_jac
-        if self.events:
-            dirs = (ctypes.c_int * len(self.events))(*[event_direction(e) for e in self.events])
-            keep.append(dirs)
-            ms.n_roots, ms.roots, ms.root_dir = len(self.events), b.c_roots, ctypes.cast(dirs, _lib.P_int)
-        self._mstruct = ms
+        self._mstruct, keep = build_model_struct(self.model, self.bridge, self.events)
         return keep
 
     # ---- lifetime ----
@@ -310,20 +340,7 @@ class Integrator:
         st = _lib.lib.fesd_last_step_data(self._ptr(), _byref(d))
         if st < 0:
             self._raise(st, "fesd_last_step_data")
-        n, s, nth = d.n_elements, d.stages, d.n_theta
-        m = self.model
-        # internal subsystems (the user's first, then the drift / clock and stop conditions):
-        # d.n_sys is the stride of mu; the user's modes come first in theta and lambda
-        nsys_int = d.n_sys
-        n_user = sum(sub.n_modes for sub in m.subsystems)
-
-        def arr(p, size):
-            return np.ctypeslib.as_array(p, shape=(size,)).copy() if size > 0 and p else np.zeros(0)
-        x = arr(d.x, (n + 1) * d.nx).reshape(n + 1, d.nx)[:, : self.nx]
-        th = arr(d.theta, n * s * nth).reshape(n, s, nth)[:, :, :n_user]
-        la = arr(d.lambda_, n * s * nth).reshape(n, s, nth)[:, :, :n_user]
-        mu = arr(d.mu, n * s * nsys_int).reshape(n, s, nsys_int)[:, :, : m.nsys]
-        return StepData(arr(d.h, n), arr(d.t, n + 1), x, th, la, mu)
+        return StepData(*step_data(d, self.model))
 
     def dense_output(self, t):
         """x(t) inside the last accepted step (collocation families)."""

@@ -108,6 +108,35 @@ def ocp_exact(t):
     return np.array([q1, math.pi / 3 - t if t < t1 else 0.05 * q1 ** 3, 0.0, 0.0])
 
 
+OCP_STEP_EQ_TARGET = np.array([-math.pi / 6, -math.pi / 4])
+
+
+def ocp_step_eq(n_ctrl=6, jacobians=True, **kwargs):
+    """Paper Sec. 6.3 (src/problems/ocp_step_eq.c) as a fesd.OCP on ocp_dynamics(): x0 = OCP_X0,
+    T = 4, |v| <= 2, |u| <= 10, cost int u'u + v'v dt (lagrange_lsq r = (u, v)) + 1e3 ||q(4) -
+    (-pi/6, -pi/4)||_1. jacobians=False: the OCP functions without Jacobians (central
+    differences in the wrapper). kwargs: fesd.OCP's (stages, n_fe, method, OCP settings, ...).
+    Start it from ocp_step_eq_guess(n_ctrl) as the C tests do."""
+    from .ocp import OCP
+    qf = OCP_STEP_EQ_TARGET
+    Jl_x, Jl_u = np.zeros((4, 4)), np.zeros((4, 2))
+    Jl_x[2, 2] = Jl_x[3, 3] = Jl_u[0, 0] = Jl_u[1, 1] = 1.0
+    J1 = np.zeros((2, 4))
+    J1[0, 0] = J1[1, 1] = 1.0
+    inf = math.inf
+    return OCP(ocp_dynamics(), n_ctrl, 0.0, 4.0, OCP_X0, x_lb=[-inf, -inf, -2, -2], x_ub=[inf, inf, 2, 2],
+               u_lb=-10.0, u_ub=10.0,
+               lagrange_lsq=lambda t, x, u: np.array([u[0], u[1], x[2], x[3]]),
+               lagrange_lsq_jac=(lambda t, x, u: (Jl_x, Jl_u)) if jacobians else None,
+               l1=lambda x: np.array([x[0] - qf[0], x[1] - qf[1]]), l1_jac=(lambda x: J1) if jacobians else None,
+               l1_weight=[1e3, 1e3], **kwargs)
+
+
+def ocp_step_eq_guess(n_ctrl=6):
+    """The C tests' control guess (fesd_ocp_step_eq_guess): -1 on the first half, 0 after."""
+    return np.array([[-1.0, -1.0] if 2 * k < n_ctrl else [0.0, 0.0] for k in range(n_ctrl)])
+
+
 def stewart_anitescu():
     """Paper Sec. 5.3: x' in 2 - sign(x) with the running cost q' = x^2 (states x, q)."""
     sub = Subsystem(2, fields=lambda t, x, u: np.array([[1.0, x[0] ** 2], [3.0, x[0] ** 2]]),

@@ -6,6 +6,9 @@
  *   fesd_py_reference integrate PROBLEM FAMILY STAGES RTOL ATOL T [u...]     (fesd_integrate)
  *   fesd_py_reference grid PROBLEM FAMILY STAGES RTOL ATOL N t_1..t_N [u...] (fesd_integrate_grid)
  *   fesd_py_reference time PROBLEM FAMILY STAGES NSIM T REPS                 (CPU us per fesd_step)
+ *   fesd_py_reference ocp_step_eq METHOD FAMILY STAGES N_FE N_CTRL [HESSIAN] (fesd_ocp_solve of the
+ *                     paper's ocp_step_eq from its control guess; HESSIAN 0..3 as fesd_ocp_hessian)
+ *   fesd_py_reference ocp_layout                                             (every field of the OCP structs)
  *
  * Output: one record per line, "name v1 v2 ...". */
 #include <stddef.h>
@@ -43,6 +46,47 @@ static int layout(void) {
   OFF(fesd_integrate_info, t); OFF(fesd_integrate_info, n_done); OFF(fesd_integrate_info, h_next);
   printf("size fesd_stats %zu\n", sizeof(fesd_stats));
   OFF(fesd_stats, events); OFF(fesd_stats, time); OFF(fesd_stats, mean_iter_switch_step);
+  return 0;
+}
+
+/* every field of the OCP structs (python/tests/test_ocp.py checks all of them) */
+static int ocp_layout(void) {
+  printf("size fesd_ocp_problem %zu\n", sizeof(fesd_ocp_problem));
+  OFF(fesd_ocp_problem, model); OFF(fesd_ocp_problem, n_ctrl); OFF(fesd_ocp_problem, t0); OFF(fesd_ocp_problem, tf);
+  OFF(fesd_ocp_problem, x0); OFF(fesd_ocp_problem, x0_lb); OFF(fesd_ocp_problem, x0_ub); OFF(fesd_ocp_problem, x_lb);
+  OFF(fesd_ocp_problem, x_ub); OFF(fesd_ocp_problem, u_lb); OFF(fesd_ocp_problem, u_ub);
+  OFF(fesd_ocp_problem, lagrange); OFF(fesd_ocp_problem, n_lagrange_lsq); OFF(fesd_ocp_problem, lagrange_lsq);
+  OFF(fesd_ocp_problem, mayer); OFF(fesd_ocp_problem, n_mayer_lsq); OFF(fesd_ocp_problem, mayer_lsq);
+  OFF(fesd_ocp_problem, n_l1); OFF(fesd_ocp_problem, l1); OFF(fesd_ocp_problem, l1_weight);
+  OFF(fesd_ocp_problem, n_path); OFF(fesd_ocp_problem, path); OFF(fesd_ocp_problem, path_lb);
+  OFF(fesd_ocp_problem, path_ub); OFF(fesd_ocp_problem, n_term); OFF(fesd_ocp_problem, terminal);
+  OFF(fesd_ocp_problem, term_lb); OFF(fesd_ocp_problem, term_ub); OFF(fesd_ocp_problem, user);
+  printf("size fesd_ocp_settings %zu\n", sizeof(fesd_ocp_settings));
+  OFF(fesd_ocp_settings, integrator); OFF(fesd_ocp_settings, hessian); OFF(fesd_ocp_settings, max_iter);
+  OFF(fesd_ocp_settings, tol_stat); OFF(fesd_ocp_settings, tol_feas); OFF(fesd_ocp_settings, tol_comp);
+  OFF(fesd_ocp_settings, penalty0); OFF(fesd_ocp_settings, penalty_max); OFF(fesd_ocp_settings, armijo);
+  OFF(fesd_ocp_settings, backtrack); OFF(fesd_ocp_settings, max_backtracks); OFF(fesd_ocp_settings, soc);
+  OFF(fesd_ocp_settings, nonmonotone); OFF(fesd_ocp_settings, reg_primal); OFF(fesd_ocp_settings, reg_dual);
+  OFF(fesd_ocp_settings, qp_tol); OFF(fesd_ocp_settings, qp_max_iter); OFF(fesd_ocp_settings, stall_window);
+  OFF(fesd_ocp_settings, qp_backend); OFF(fesd_ocp_settings, init); OFF(fesd_ocp_settings, presolve);
+  OFF(fesd_ocp_settings, presolve_n_fe); OFF(fesd_ocp_settings, verbose); OFF(fesd_ocp_settings, log);
+  OFF(fesd_ocp_settings, log_user);
+  printf("size fesd_ocp_info %zu\n", sizeof(fesd_ocp_info));
+  OFF(fesd_ocp_info, status); OFF(fesd_ocp_info, iterations); OFF(fesd_ocp_info, qp_iterations);
+  OFF(fesd_ocp_info, qp_elastic); OFF(fesd_ocp_info, qp_failures); OFF(fesd_ocp_info, line_search_trials);
+  OFF(fesd_ocp_info, soc_steps); OFF(fesd_ocp_info, hessian_updates); OFF(fesd_ocp_info, hessian_skipped);
+  OFF(fesd_ocp_info, hessian_resets); OFF(fesd_ocp_info, integrations); OFF(fesd_ocp_info, integrator_failures);
+  OFF(fesd_ocp_info, integrator_flags); OFF(fesd_ocp_info, objective); OFF(fesd_ocp_info, stationarity);
+  OFF(fesd_ocp_info, stationarity_rel); OFF(fesd_ocp_info, feasibility); OFF(fesd_ocp_info, complementarity);
+  OFF(fesd_ocp_info, min_multiplier); OFF(fesd_ocp_info, penalty); OFF(fesd_ocp_info, max_step);
+  OFF(fesd_ocp_info, time_total); OFF(fesd_ocp_info, time_integration); OFF(fesd_ocp_info, time_qp);
+  OFF(fesd_ocp_info, time_other); OFF(fesd_ocp_info, hessian_fallback); OFF(fesd_ocp_info, stalled);
+  OFF(fesd_ocp_info, stall_interval); OFF(fesd_ocp_info, presolve_run); OFF(fesd_ocp_info, presolve_status);
+  OFF(fesd_ocp_info, presolve_iterations); OFF(fesd_ocp_info, presolve_used);
+  printf("size fesd_ocp_multipliers %zu\n", sizeof(fesd_ocp_multipliers));
+  OFF(fesd_ocp_multipliers, dynamics); OFF(fesd_ocp_multipliers, x0); OFF(fesd_ocp_multipliers, x_bound);
+  OFF(fesd_ocp_multipliers, u_bound); OFF(fesd_ocp_multipliers, path); OFF(fesd_ocp_multipliers, terminal);
+  OFF(fesd_ocp_multipliers, l1);
   return 0;
 }
 
@@ -87,8 +131,69 @@ static fesd_integrator *make(fesd_problem *P, const char *method, const char *fa
   return it;
 }
 
+/* ocp_step_eq through the C API: status, info, solution, multipliers and events per interval */
+static int ocp_step_eq(fesd_problem *P, const char *method, const char *family, int stages, int n_fe, int n_ctrl,
+                       int hessian) {
+  fesd_ocp_problem op;
+  fesd_ocp_step_eq(&op, &P->model);
+  op.n_ctrl = n_ctrl;
+  fesd_ocp_settings s;
+  fesd_ocp_settings_default(&s);
+  s.integrator.method = !strcmp(method, "standard") ? FESD_METHOD_STANDARD : FESD_METHOD_FESD;
+  if (parse_family(family, &s.integrator.family)) return 2;
+  s.integrator.stages = stages;
+  s.integrator.n_fe = n_fe;
+  s.hessian = (fesd_ocp_hessian)hessian;
+  fesd_ocp *o;
+  int st = fesd_ocp_create(&o, &op, &s);
+  if (st) {
+    printf("status %d\n", st);
+    return 0;
+  }
+  double *ug = malloc(sizeof(double) * 2 * (size_t)n_ctrl), *u = malloc(sizeof(double) * 2 * (size_t)n_ctrl);
+  double *x = malloc(sizeof(double) * 4 * (size_t)(n_ctrl + 1));
+  fesd_ocp_step_eq_guess(ug, n_ctrl);
+  fesd_ocp_set_guess(o, NULL, ug);
+  fesd_ocp_info info;
+  st = fesd_ocp_solve(o, &info);
+  fesd_ocp_get_solution(o, x, u);
+  printf("objective %.17g\n", info.objective);
+  printf("kkt %.17g %.17g %.17g %.17g\n", info.stationarity_rel, info.feasibility, info.complementarity,
+         info.min_multiplier);
+  printf("work %d %d %d %d\n", info.iterations, info.integrations, info.presolve_run, info.presolve_iterations);
+  vec("u", u, 2 * n_ctrl);
+  vec("xsol", x, 4 * (n_ctrl + 1));
+  fesd_ocp_multipliers m;
+  fesd_ocp_get_multipliers(o, &m);
+  vec("m_dynamics", m.dynamics, 4 * n_ctrl);
+  vec("m_u_bound", m.u_bound, 2 * n_ctrl);
+  vec("m_l1", m.l1, 2);
+  for (int k = 0; k < n_ctrl; k++) {
+    const fesd_event *ev;
+    int ne;
+    fesd_step_data d;
+    if (fesd_ocp_interval(o, k, &d, &ev, &ne) == FESD_OK) {
+      printf("interval %d %d", k, d.n_elements);
+      for (int e = 0; e < d.n_elements; e++) printf(" %.17g", d.h[e]);
+      printf("\n");
+      events(ev, ne);
+    }
+  }
+  printf("status %d\n", st);
+  fesd_ocp_free(&o);
+  free(ug), free(u), free(x);
+  return 0;
+}
+
 int main(int argc, char **argv) {
   if (argc >= 2 && !strcmp(argv[1], "layout")) return layout();
+  if (argc >= 2 && !strcmp(argv[1], "ocp_layout")) return ocp_layout();
+  if (argc >= 7 && !strcmp(argv[1], "ocp_step_eq")) {
+    fesd_problem P;
+    fesd_problem_get("ocp-dynamics", &P);
+    return ocp_step_eq(&P, argv[2], argv[3], atoi(argv[4]), atoi(argv[5]), atoi(argv[6]),
+                       argc >= 8 ? atoi(argv[7]) : 0);
+  }
   if (argc < 3) {
     fprintf(stderr, "usage: see the top of reference.c\n");
     return 2;
