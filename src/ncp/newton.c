@@ -172,7 +172,14 @@ static int line_search(fesd_ncp *ws, double *z, stage_state *ss, double gd, int 
       t *= s->backtrack;
       st->backtracks++;
     }
-    for (int i = 0; i < n; i++) ws->zt[i] = z[i] + t * ws->d[i];
+    int finite = 1;
+    for (int i = 0; i < n; i++) {
+      ws->zt[i] = z[i] + t * ws->d[i];
+      finite &= isfinite(ws->zt[i]);
+    }
+    /* a direction with NaN/Inf (a factorization that overflowed) gives no trial point: the
+     * callbacks are never called with non-finite arguments (a user's model may assert on them) */
+    if (!finite) continue;
     project(ws, ws->zt);
     int rc = fesd__ncp_call(ws, ws->zt, ws->raw_t, NULL, st);
     if (rc == FESD_ERR_CALLBACK) return rc;

@@ -8,7 +8,10 @@
  *    same objective as without it;
  *  - a presolve whose point the requested discretisation cannot evaluate falls back to the guess
  *    (then the solve is the one without presolve);
- *  - the settings' ranges. */
+ *  - the settings' ranges;
+ *  - the model's callbacks never see a non-finite t, x or u (the semismooth Newton's line
+ *    search used to evaluate trial points of a direction with NaN entries: t = NaN in the
+ *    model; a user's model may assert on that). */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -21,6 +24,33 @@
 #define N 6
 
 static int fails;
+
+/* The model with its callbacks wrapped: counts calls with non-finite arguments. */
+static fesd_model inner;
+static int nonfinite_calls;
+static void check_args(double t, const double *x, const double *u) {
+  int ok = isfinite(t);
+  for (int i = 0; i < inner.nx; i++) ok &= isfinite(x[i]);
+  for (int i = 0; i < inner.nu; i++) ok &= isfinite(u[i]);
+  nonfinite_calls += !ok;
+}
+static int w_field(int sys, int mode, double t, const double *x, const double *u, double *f, void *user) {
+  check_args(t, x, u);
+  return inner.field(sys, mode, t, x, u, f, user);
+}
+static int w_field_jac(int sys, int mode, double t, const double *x, const double *u, double *J, double *Ju,
+                       void *user) {
+  check_args(t, x, u);
+  return inner.field_jac(sys, mode, t, x, u, J, Ju, user);
+}
+static int w_sw(int sys, double t, const double *x, const double *u, double *c, void *user) {
+  check_args(t, x, u);
+  return inner.sw(sys, t, x, u, c, user);
+}
+static int w_sw_jac(int sys, double t, const double *x, const double *u, double *J, double *Ju, void *user) {
+  check_args(t, x, u);
+  return inner.sw_jac(sys, t, x, u, J, Ju, user);
+}
 
 static fesd_ocp *make(const fesd_ocp_problem *op, int method, fesd_rk_family fam, int s, int nfe, int presolve) {
   fesd_ocp_settings set;
@@ -48,8 +78,14 @@ static int solve(fesd_ocp *o, const double *x0, double *u, fesd_ocp_info *info) 
 int main(void) {
   fesd_problem P;
   fesd_problem_get("ocp-dynamics", &P);
+  inner = P.model;
+  fesd_model wrapped = inner;
+  wrapped.field = w_field;
+  wrapped.sw = w_sw;
+  if (inner.field_jac) wrapped.field_jac = w_field_jac;
+  if (inner.sw_jac) wrapped.sw_jac = w_sw_jac;
   fesd_ocp_problem op;
-  fesd_ocp_step_eq(&op, &P.model);
+  fesd_ocp_step_eq(&op, &wrapped);
   double u0[2 * N], u1[2 * N];
   fesd_ocp_info i0, i1;
 
@@ -134,6 +170,8 @@ int main(void) {
   }
   fesd_ocp_settings_default(&set);
   CHECK(set.presolve == 1 && set.presolve_n_fe == 2, "defaults %d %d", set.presolve, set.presolve_n_fe);
+  printf("model calls with non-finite t, x or u: %d\n", nonfinite_calls);
+  CHECK(nonfinite_calls == 0, "%d model calls with non-finite arguments", nonfinite_calls);
   if (fails) printf("%d check(s) failed\n", fails);
   return fails ? 1 : 0;
 }
