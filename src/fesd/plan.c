@@ -20,6 +20,10 @@
 #define MAX_TRIES 4
 /* A switch predicted this close to the step start (fraction of T) happens at the start. */
 #define AT_START 1e-9
+/* ... and one predicted this close (not farther than the prediction error of an entry just
+ * after the start, 14 % measured) may be moved there when its element cannot be that short
+ * (fesd__plan_start_fallback). */
+#define START_REACH 1e-8
 
 void fesd__plan_reset(fesd_integrator *it) {
   it->n_plan = 0;
@@ -268,6 +272,45 @@ static void start_jump(fesd_integrator *it, int k, const unsigned char *newset) 
     it->jump_out[k] = out;
   }
   memcpy(it->act0 + m->th_off[k], newset + m->th_off[k], (size_t)(m->th_off[k + 1] - m->th_off[k]));
+  /* The start now counts as on the surface: lambda00 of the start set's modes is zero (it
+   * enters the first boundary's cross-complementarity row through element 0). Left at
+   * g(x0) - min g, a start 2.6e-10 off the sliding surface (ocp_step_eq, Lobatto IIIC s = 2)
+   * carried 5e-10 into that row, which the solve balanced by lambda = -5.2e-9 (relative) of the
+   * other subsystem's entering mode at that boundary: a sign violation every round, a plan
+   * cycle and a finer layout (5 elements instead of 2). Restored with the state when the
+   * attempt fails (fesd__load). */
+  for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) {
+    if (!newset[i]) continue;
+    it->lam00[i] = 0.0;
+    if (it->set.sensitivities)
+      for (int c = 0; c < it->np; c++) it->sys.lam00_dp[(size_t)c * it->nth + i] = 0.0;
+  }
+}
+
+/* A plan solve that failed with its first element at the floor of its length (1e-9 T, the
+ * bound of every element) while the first boundary carries entries: those switches lie closer
+ * to the start than an element can be short, and their predictions only just missed the
+ * step-start rule (AT_START). Measured (ocp_step_eq, Lobatto IIIC s = 2, a start 4.3e-10 off
+ * the sliding surface): an entry predicted at 6.76e-10 > 6.67e-10 = AT_START T, true 5.9e-10;
+ * three plan solves stalled at residual 3.5e-10 with h_0 at the bound and the step ended in
+ * two sub-steps (5 elements). They move to the start; the other switches' brackets came from
+ * the trajectory before that change and are released. Returns 1 when the plan changed. */
+int fesd__plan_start_fallback(fesd_integrator *it, const double *z) {
+  const fesd__system *S = &it->sys;
+  const double T = S->T;
+  if (S->N < 2 || !(z[S->ho[0]] <= 1.000001e-9 * T)) return 0;
+  int moved = 0;
+  for (int e = it->n_plan - 1; e >= 0; e--) {
+    /* only switches predicted near the start: a wrong plan can drive h_0 to the floor too
+     * (bang-bang oscillator, hard_silent: crossings predicted mid-step moved to the start gave
+     * FESD_OK with errors of 0.63) */
+    if (it->plan[e].kb != 1 || it->plan[e].exit || !(it->plan[e].t <= START_REACH * T)) continue;
+    start_jump(it, it->plan[e].sys, after(it, e));
+    fesd__plan_remove(it, e);
+    moved = 1;
+  }
+  for (int e = 0; e < it->n_plan && moved; e++) it->plan[e].lo = 0.0, it->plan[e].hi = T;
+  return moved;
 }
 
 /* Whether the switch of subsystem j can make theta of subsystem k jump at time t: some
@@ -315,6 +358,8 @@ static void remove_if_unchanged(fesd_integrator *it, int e) {
   if (!memcmp(after(it, e) + a, set_before_switch(it, e) + a, (size_t)(b - a))) fesd__plan_remove(it, e);
 }
 
+/* Returns 1 when the plan changed, 2 when the start's set changed (a switch at the step start),
+ * 0 when it gives up, < 0 on errors. */
 static int update_one(fesd_integrator *it, const double *z, const fesd__violation *v, double T) {
   const fesd__model *m = &it->model;
   const int k = v->sys, a = m->th_off[k], b = m->th_off[k + 1];
@@ -329,7 +374,7 @@ static int update_one(fesd_integrator *it, const double *z, const fesd__violatio
     if (e < 0) {
       start_jump(it, k, ns);
       drop_after(it, k, -1.0);
-      return 1;
+      return 2;
     }
     if (++it->plan[e].tries > MAX_TRIES || !memcmp(after(it, e) + a, ns + a, (size_t)(b - a))) return 0;
     memcpy(after(it, e) + a, ns + a, (size_t)(b - a));
@@ -375,7 +420,7 @@ static int update_one(fesd_integrator *it, const double *z, const fesd__violatio
   }
   if (t_v <= AT_START * T && e < 0) {
     start_jump(it, k, ns);
-    return 1;
+    return 2;
   }
   /* An exit whose sign change brackets a switch of another subsystem: at a corner the other
    * subsystem's switch makes theta jump (design of a sliding mode that cannot continue past
@@ -418,18 +463,22 @@ int fesd__plan_update(fesd_integrator *it, const double *z, const fesd__violatio
   double t_first = INFINITY;
   for (int k = 0; k < it->nsys; k++)
     if (per_sys[k].found && per_sys[k].first) t_first = fmin(t_first, per_sys[k].t);
+  double t_new = INFINITY;
   for (int k = 0; k < it->nsys; k++) {
     if (!per_sys[k].found) continue;
     if (!per_sys[k].first && per_sys[k].t > t_first + 1e-9 * T) continue;
     int r = update_one(it, z, &per_sys[k], T);
     if (r < 0) return r;
     if (r == 0) return 0;
+    if (r == 2) t_new = 0.0; /* a switch moved to the step start changes the whole trajectory */
     changed = 1;
   }
   /* The brackets of the new switches come from the predicting trajectory; after the earliest
-   * new switch that trajectory changes (coupled subsystems: a mass that sticks moves its
-   * neighbours' exits), so the later ones may move anywhere after it. */
-  double t_new = INFINITY;
+   * new switch (or a change of the start's set) that trajectory changes (coupled subsystems: a
+   * mass that sticks moves its neighbours' exits; ocp_step_eq, Radau IIA s = 2, a start
+   * 2.6e-10 off the sliding surface c2 = 0: the other subsystem's entry at 0.4436 was
+   * bracketed in [0.4444, 0.6667] by the trajectory that crossed c2, the plan solve stalled at
+   * residual 1.3e-3 and the step was halved), so the later ones may move anywhere after it. */
   for (int e = 0; e < it->n_plan; e++)
     if (it->plan[e].fresh) t_new = fmin(t_new, it->plan[e].t);
   for (int e = 0; e < it->n_plan; e++) {

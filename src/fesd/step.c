@@ -296,6 +296,8 @@ static int plan_path(fesd_integrator *it, double *T, fesd_step_info *info) {
       st = fesd__fixed_solve(it, z, it->set.max_iter < PLAN_ITER ? it->set.max_iter : PLAN_ITER, PLAN_SLOW_ITER, info);
       if (st == FESD_OK) break;
       if (fesd__hard_failure(st)) return st;
+      /* its first element at the length floor: the entries there move to the start */
+      if (fesd__plan_start_fallback(it, z)) continue;
       if (!it->split_layout) { /* first: the same plan without elements longer than T / N_FE */
         const int N0 = S->N;
         it->split_layout = 1;

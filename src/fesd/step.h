@@ -101,6 +101,9 @@ int fesd__plan_update(fesd_integrator *it, const double *z, const fesd__violatio
  * half of them (the later ones were predicted from a trajectory that the earlier ones change).
  * Returns 1 if it changed the plan, 0 if there is nothing to take back. */
 int fesd__plan_retreat(fesd_integrator *it);
+/* A failed plan solve whose first element sits at its length's floor: the entries on the first
+ * boundary move to the step start. Returns 1 when the plan changed. */
+int fesd__plan_start_fallback(fesd_integrator *it, const double *z);
 /* A hash of the plan's switches in time order (subsystem, mode, kind, time), to detect cycles. */
 unsigned long fesd__plan_signature(fesd_integrator *it);
 /* Number of distinct subsystems that switch in the plan. */

@@ -86,12 +86,18 @@ void fesd__state_at(fesd_integrator *it, const double *z, int N, double t, doubl
     fesd__poly_state(it, z, n, w, x);
     return;
   }
-  /* piecewise linear through (0, x_n), (c_j, X_j), (1, x_{n+1}) */
+  /* piecewise linear through (0, x_n), (c_j, X_j) for c_j > 0, (1, x_{n+1}). A stage at c_j = 0
+   * is not the element start: Lobatto IIIC's X_1 = x_n + h (v_1 - v_2) / 2 lies O(h^2) off it.
+   * Through X_1 the path began 1e-2 off x_0 in lambda (ocp_step_eq, s = 2, h = 1/3), and the
+   * refinement of an entry 1.8e-10 after the step start returned 2.0e-2 (predict.c), beyond
+   * the reach of the step-start rule (plan.c, AT_START), which the plan then could not solve
+   * (the element length's lower bound 1e-9 T is above the true 1.9e-10). */
   const double *xn = n == 0 ? S->x0 : z + S->xo[n - 1], *x1 = z + S->xo[n];
   double ca = 0, cb = 1;
   int ja = -1, jb = -1;
   for (int j = 0; j < s; j++) {
     double c = S->tab.c[j];
+    if (c == 0.0) continue;
     if (c <= tau && c >= ca) ca = c, ja = j;
     if (c > tau && c < cb) cb = c, jb = j;
   }

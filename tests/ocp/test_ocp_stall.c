@@ -1,7 +1,7 @@
-/* The no-progress rule (settings.stall_window) on ocp_step_eq with FESD Lobatto IIIC s = 2,
- * N_FE = 2: the step map of interval 3 is discontinuous / kinked at the iterates (node x_3 at the
- * co-dimension-2 sliding point), so the SQP only creeps (alpha 1/64 for 200 iterations before
- * the rule). Checks: the bounded failure (status, counts), that the returned iterate is a logged
+/* The no-progress rule (settings.stall_window) on ocp_step_eq with FESD Radau IIA s = 1,
+ * N_FE = 2, no presolve: the step map of interval 3 jumps at the iterates (node x_3 at the
+ * co-dimension-2 sliding point), so the SQP only creeps. (Until the start-near-surface fix of
+ * the integrator this test used Lobatto IIIC s = 2, which now converges.) Checks: the bounded failure (status, counts), that the returned iterate is a logged
  * one with the reported residuals and satisfies the dynamics to the reported feasibility
  * (independent re-simulation), Gauss-Newton stopping after one window, the range check, and a
  * converging solve untouched by the rule. */
@@ -106,20 +106,26 @@ int main(void) {
   const int W = 6; /* default stall_window */
 
   /* GN_SR1 (AUTO): one window, fallback to Gauss-Newton, a second window, stop */
-  int st = solve(&P, FESD_RK_LOBATTO_IIIC, 2, FESD_OCP_HESSIAN_AUTO, &info, x, u, &is);
-  printf("lobatto3c s=2 N_FE=2: %s, %d it, %d integrations, f %.10f, stat %.2e, feas %.2e, %.0f ms\n",
+  int st = solve(&P, FESD_RK_RADAU_IIA, 1, FESD_OCP_HESSIAN_AUTO, &info, x, u, &is);
+  printf("radau s=1 N_FE=2: %s, %d it, %d integrations, f %.10f, stat %.2e, feas %.2e, %.0f ms\n",
          fesd_status_name(st), info.iterations, info.integrations, info.objective, info.stationarity_rel,
          info.feasibility, 1e3 * info.time_total);
   CHECK(st == FESD_ERR_LINE_SEARCH && info.status == st, "status %s", fesd_status_name(st));
   CHECK(info.stalled == 1 && info.hessian_fallback == 1, "stalled %d fallback %d", info.stalled, info.hessian_fallback);
-  /* the interval named by the rule is where the NLP is not smooth: one-sided differences of its
-   * map disagree (measured 4.5e6 with e = 1e-7: a jump of 0.45 in Phi_3), those of interval 0
-   * agree (2.2e-9) */
+  /* the rule names the interval k whose switch structure changed at the rejected trials; the
+   * NLP is not smooth at its end node x_{k+1} (the co-dimension-2 sliding point): one-sided
+   * differences of Phi_{k+1} disagree (measured 6.6e5 with e = 1e-7: a jump of 0.066 in Phi_3,
+   * k = 2), those of interval 0 agree (2.2e-9). (Lobatto IIIC s = 2, which stalled here before,
+   * converges since the integrator solves starts within 1e-9 T of the sliding surface without
+   * halving: tests/hard/test_start_near_surface.c.) */
   CHECK(info.stall_interval >= 0 && info.stall_interval < N, "stall_interval %d", info.stall_interval);
   if (info.stall_interval >= 0 && info.stall_interval < N) {
-    const double g = one_sided_gap(&P, &is, info.stall_interval, x, u, 1e-7), g0 = one_sided_gap(&P, &is, 0, x, u, 1e-7);
-    printf("  stall_interval %d: one-sided difference gap %.2e (interval 0: %.2e)\n", info.stall_interval, g, g0);
-    CHECK(g > 1e3 * g0 && g > 1.0, "gap %.3e at interval %d vs %.3e at interval 0", g, info.stall_interval, g0);
+    const int k = info.stall_interval;
+    double g = one_sided_gap(&P, &is, k, x, u, 1e-7);
+    if (k + 1 < N) g = fmax(g, one_sided_gap(&P, &is, k + 1, x, u, 1e-7));
+    const double g0 = one_sided_gap(&P, &is, 0, x, u, 1e-7);
+    printf("  stall_interval %d: one-sided difference gap %.2e at it or the next (interval 0: %.2e)\n", k, g, g0);
+    CHECK(g > 1e3 * g0 && g > 1.0, "gap %.3e at interval %d or %d vs %.3e at interval 0", g, k, k + 1, g0);
   }
   CHECK(info.iterations >= 2 * W && info.iterations <= 2 * W + 20, "iterations %d (before the rule: 200)", info.iterations);
   CHECK(info.integrations < 2000, "integrations %d (before the rule: 16190)", info.integrations);
@@ -141,11 +147,11 @@ int main(void) {
   CHECK(info.feasibility > 0 && info.feasibility < 1e-3, "feasibility %.3e", info.feasibility);
 
   /* plain Gauss-Newton: no fallback, stops after the first window */
-  st = solve(&P, FESD_RK_LOBATTO_IIIC, 2, FESD_OCP_HESSIAN_GAUSS_NEWTON, &info, x, u, &is);
+  st = solve(&P, FESD_RK_RADAU_IIA, 1, FESD_OCP_HESSIAN_GAUSS_NEWTON, &info, x, u, &is);
   printf("same, Gauss-Newton: %s, %d it\n", fesd_status_name(st), info.iterations);
   CHECK(st == FESD_ERR_LINE_SEARCH && info.stalled == 1 && info.hessian_fallback == 0, "GN: %s stalled %d fallback %d",
         fesd_status_name(st), info.stalled, info.hessian_fallback);
-  CHECK(info.iterations >= W && info.iterations <= W + 15, "GN iterations %d", info.iterations);
+  CHECK(info.iterations >= W && info.iterations <= W + 20, "GN iterations %d", info.iterations);
 
   /* a converging solve is untouched */
   st = solve(&P, FESD_RK_RADAU_IIA, 2, FESD_OCP_HESSIAN_AUTO, &info, x, u, &is);
