@@ -214,6 +214,11 @@ typedef struct {
 #define FESD_FLAG_COARSE 0x8    /**< the step's local error estimate exceeds its tolerance
                                      (settings.coarse_tol, relative): the step is too long for the
                                      accuracy of the solution */
+#define FESD_FLAG_AMBIGUOUS 0x10 /**< a subsystem ran along one of its surfaces in one mode, its
+                                     side decided below the resolution of the sign checks, while
+                                     the other side's field would have moved the state by more
+                                     than the tolerances: the state may be off (e.g. just past a
+                                     Zeno accumulation) */
 
 /** Statistics of one fesd_step() (accumulated over sub-steps when it splits). */
 typedef struct {
@@ -400,6 +405,7 @@ typedef struct {
   double mean_iter_ordinary_step;
   double max_iter_switch_step;
   double mean_iter_switch_step;
+  int ambiguous_steps;     /**< steps flagged FESD_FLAG_AMBIGUOUS */
 } fesd_stats;
 
 FESD_API int fesd_get_stats(const fesd_integrator *it, fesd_stats *stats);

@@ -14,7 +14,7 @@ from .model import event_direction, event_terminal
 
 _STAT_SUM = ("steps", "switch_steps", "newton_iter", "factorizations", "solves", "homotopy_stages", "splits",
              "fallback_steps", "substeps", "nonunique_steps", "sens_inaccurate_steps", "exit_not_pinned_steps",
-             "coarse_steps", "failed_steps", "rejected_steps", "events", "time")
+             "coarse_steps", "failed_steps", "rejected_steps", "events", "time", "ambiguous_steps")
 
 
 class Stop(Exception):

@@ -87,7 +87,7 @@ class Stats(ctypes.Structure):
         "fallback_steps", "substeps", "nonunique_steps", "sens_inaccurate_steps", "exit_not_pinned_steps",
         "coarse_steps", "failed_steps", "rejected_steps", "events")] + [
         (n, c_double) for n in ("time", "max_iter_ordinary_step", "mean_iter_ordinary_step",
-                                "max_iter_switch_step", "mean_iter_switch_step")]
+                                "max_iter_switch_step", "mean_iter_switch_step")] + [("ambiguous_steps", c_int)]
 
 
 # ---- optimal control (fesd_ocp.h) ----
@@ -146,7 +146,7 @@ FAMILIES = {"radau": 0, "gauss": 1, "lobatto3a": 2, "lobatto3c": 3, "explicit": 
 COLLOCATION = ("radau", "gauss", "lobatto3a")  # families with a collocation polynomial
 METHODS = {"fesd": 0, "standard": 1}
 EVENT_KINDS = ("crossing", "sliding_entry", "sliding_exit", "root")
-FLAGS = {0x1: "nonunique", 0x2: "sens_inaccurate", 0x4: "exit_not_pinned", 0x8: "coarse"}
+FLAGS = {0x1: "nonunique", 0x2: "sens_inaccurate", 0x4: "exit_not_pinned", 0x8: "coarse", 0x10: "ambiguous"}
 
 _HERE = os.path.dirname(os.path.abspath(__file__))
 

@@ -447,6 +447,7 @@ int fesd_step(fesd_integrator *it, const double *u, double T, fesd_step_info *in
   S->sens_inaccurate_steps += (info->flags & FESD_FLAG_SENS_INACCURATE) != 0;
   S->exit_not_pinned_steps += (info->flags & FESD_FLAG_EXIT_NOT_PINNED) != 0;
   S->coarse_steps += (info->flags & FESD_FLAG_COARSE) != 0;
+  S->ambiguous_steps += (info->flags & FESD_FLAG_AMBIGUOUS) != 0;
   S->events += it->n_events;
   S->time += info->time;
   int sw = info->switch_step || info->splits > 0 || info->substeps > 0;

@@ -86,6 +86,39 @@ int main(void) {
              s, nsim, fesd_status_name(st), R.info.failed_time, gap, R.t_end, R.stats.events, worst, R.stats.steps,
              R.stats.newton_iter, R.stats.splits, R.info.newton_iter, R.info.splits);
     }
+  /* A step that ends just past T_acc (from the last grid point before it): the solution is at
+   * the origin there. Asserted: the step fails, or its state is within 1e-9 of the origin, or
+   * it is flagged FESD_FLAG_AMBIGUOUS (measured before the flag: FESD_OK unflagged with x2 off
+   * by 6e-7 .. 1.2e-6; the side of x1 ~ 1e-13 was decided below the sign checks' floor). */
+  const double past[3] = {3e-7, 1e-6, 1e-5};
+  int n_ok = 0, n_flagged = 0;
+  for (int s = 2; s <= 3; s++)
+    for (int c = 0; c < 3; c++) {
+      fesd_settings set;
+      fesd_settings_default(&set);
+      set.stages = s;
+      fesd_integrator *it = NULL;
+      int st = fesd_create(&it, &m, &set);
+      if (!st) st = fesd_set_state(it, 0.0, x0, NULL);
+      const double H = 0.12;
+      double t = 0, x[2];
+      while (!st && t + H < Tacc) {
+        st = fesd_step(it, NULL, H, NULL);
+        fesd_get_state(it, &t, NULL);
+      }
+      fesd_step_info info;
+      if (!st) st = fesd_step(it, NULL, Tacc + past[c] - t, &info);
+      fesd_get_state(it, &t, x);
+      const double off = fmax(fabs(x[0]), fabs(x[1]));
+      const int flagged = st == FESD_OK && (info.flags & FESD_FLAG_AMBIGUOUS);
+      n_ok += st == FESD_OK, n_flagged += flagged;
+      HD_CHECK(st != FESD_OK || off <= 1e-9 || flagged, "s=%d, step to T_acc + %.0e: FESD_OK unflagged, |x| = %.1e",
+               s, past[c], off);
+      printf("s=%d step to T_acc + %.0e: %s, |x| = %.1e, flags 0x%x\n", s, past[c], fesd_status_name(st), off,
+             st == FESD_OK ? info.flags : 0);
+      fesd_free(&it);
+    }
+  printf("steps ending past T_acc: %d of 6 FESD_OK, %d of them flagged ambiguous\n", n_ok, n_flagged);
   printf("%d failures\n", fails);
   return fails != 0;
 }
