@@ -328,6 +328,7 @@ static int ambiguous_side(fesd_integrator *it, const double *z) {
         const double w = S->wth[q], l0 = fesd__left_lambda(S, z, n)[q], lo = -it->set.newton_tol;
         int band = fabs(l0) * w <= it->set.cc_tol, wrong = l0 * w < lo;
         for (int j = 0; j < s && band; j++) {
+          if (S->tab.c[j] == 0.0) continue; /* Lobatto's first stage lies O(h^2) off the start */
           const double l = z[fesd__la(S, n, j) + q];
           band = fabs(l) * w <= it->set.cc_tol;
           wrong |= l * w < lo;
@@ -339,9 +340,7 @@ static int ambiguous_side(fesd_integrator *it, const double *z) {
           for (int r = 0; r < m->nr[k]; r++)
             eff = fmax(eff, h * fabs(Fq[r] - Fi[r]) * S->wraw[S->rx[n] + m->rows[k][r]]);
         }
-        if (eff > AMBIG_EFFECT) {
-                    return 1;
-        }
+        if (eff > AMBIG_EFFECT) return 1;
       }
     }
   }
