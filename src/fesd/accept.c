@@ -306,26 +306,20 @@ static int ambiguous_side(fesd_integrator *it, const double *z) {
   /* explicit stages are predictions (not checked for signs), and the standard method's
    * per-stage sets claim no switch detection */
   if (it->tab.is_explicit || it->set.method != FESD_METHOD_FESD || fesd__system_points(S, z, 0)) return 0;
+  int *act = event_room(it); /* scratch: the events of this step are recorded after this */
   for (int n = 0; n < S->N; n++) {
-    const double h = z[S->ho[n]];
+    const double h = z[S->ho[n]], *lam0 = fesd__left_lambda(S, z, n);
     for (int k = 0; k < it->nsys; k++) {
-      int i = -1, nact = 0;
-      for (int q = m->th_off[k]; q < m->th_off[k + 1]; q++)
-        for (int j = 0; j < s; j++)
-          if (z[fesd__th(S, n, j) + q] > it->set.active_tol) {
-            nact++, i = q;
-            break;
-          }
-      if (nact != 1) continue;
+      if (element_modes(it, z, n, k, act) != 1) continue;
+      const int i = m->th_off[k] + act[0];
       for (int q = m->th_off[k]; q < m->th_off[k + 1]; q++) {
         if (q == i) continue;
-        /* the gap at the element start too: a one-stage method's only stage point is the end,
-         * where a crossing of the element's end boundary has its gap zero */
-        /* wrong side: beyond the equations' own resolution (newton_tol, relative), where a gap
-         * that is zero (a switch on the element boundary) shows as round-off of either sign
-         * (measured 1e-35 and -7e-17 weighted at legitimate entries; -1.6e-11 to -1.8e-10 past
-         * the Zeno point) */
-        const double w = S->wth[q], l0 = fesd__left_lambda(S, z, n)[q], lo = -it->set.newton_tol;
+        /* the gap at the element start too (a one-stage method's only stage point is the end,
+         * where a crossing of the element's end boundary has a zero gap); wrong side: beyond
+         * the equations' own resolution (newton_tol, relative), where a zero gap (a switch on
+         * the element boundary) shows as round-off of either sign (measured 1e-35 and -7e-17
+         * weighted at legitimate entries; -1.6e-11 to -1.8e-10 past the Zeno point) */
+        const double w = S->wth[q], l0 = lam0[q], lo = -it->set.newton_tol;
         int band = fabs(l0) * w <= it->set.cc_tol, wrong = l0 * w < lo;
         for (int j = 0; j < s && band; j++) {
           if (S->tab.c[j] == 0.0) continue; /* Lobatto's first stage lies O(h^2) off the start */
