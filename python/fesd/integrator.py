@@ -8,6 +8,7 @@ import numpy as np
 
 from . import _lib
 from ._callbacks import Bridge
+from ._common import Handle
 from .errors import CallbackError, FesdError
 from .model import Model, event_direction
 
@@ -120,7 +121,7 @@ def step_data(d, model, n_extra=0):
     return arr(d.h, n), arr(d.t, n + 1), x, th, la, mu
 
 
-class Integrator:
+class Integrator(Handle):
     """A FESD (or standard time-stepping) integrator for a fesd.Model.
 
     method: "fesd" or "standard"; family: "radau", "gauss", "lobatto3a", "lobatto3c", "explicit";
@@ -130,6 +131,8 @@ class Integrator:
     fesd_settings by name (newton_tol, max_iter, cc_tol, active_tol, exit_rows, max_splits, ...),
     ncp_* for the solver's (e.g. ncp_backend=3 for KLU).
     """
+
+    _HANDLE, _FREE, _WHAT = "_it", "fesd_free", "integrator"
 
     def __init__(self, model, *, method="fesd", family="radau", stages=2, n_fe=2, sensitivities=False,
                  events=None, **settings):
@@ -162,28 +165,6 @@ class Integrator:
     def _build_model(self):
         self._mstruct, keep = build_model_struct(self.model, self.bridge, self.events)
         return keep
-
-    # ---- lifetime ----
-    def close(self):
-        if self._it:
-            _lib.lib.fesd_free(_byref(self._it))
-
-    def __del__(self):
-        try:
-            self.close()
-        except Exception:  # interpreter shutdown
-            pass
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
-
-    def _ptr(self):
-        if not self._it:
-            raise ValueError("the integrator is closed")
-        return self._it
 
     # ---- errors ----
     def _u(self, u):

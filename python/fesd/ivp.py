@@ -2,13 +2,14 @@
 import numpy as np
 
 from . import _drivers
+from ._common import AttrDict
 from .integrator import Integrator
 
 MESSAGES = {0: "The solver successfully reached the end of the integration interval.",
             1: "A termination event occurred."}
 
 
-class OdeResult(dict):
+class OdeResult(AttrDict):
     """Result of solve_ivp (a dict with attribute access, as scipy's).
 
     t (nt,), y (nx, nt): output points (the steps, or t_eval); sol: DenseSolution or None;
@@ -21,17 +22,7 @@ class OdeResult(dict):
     step-by-step error control).
     """
 
-    def __getattr__(self, name):
-        try:
-            return self[name]
-        except KeyError as e:
-            raise AttributeError(name) from e
-
-    __setattr__ = dict.__setitem__
-
-    def __repr__(self):
-        keys = ("status", "message", "success", "t", "y", "t_events", "switch_events", "stats")
-        return "OdeResult(\n" + "\n".join(f"  {k}: {self.get(k)!r}" for k in keys) + "\n)"
+    _REPR_KEYS = ("status", "message", "success", "t", "y", "t_events", "switch_events", "stats")
 
 
 def solve_ivp(model, t_span, y0, *, method="fesd", family="radau", stages=2, n_fe=2, rtol=None, atol=None,

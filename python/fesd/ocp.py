@@ -25,6 +25,7 @@ import numpy as np
 
 from . import _lib
 from ._callbacks import Bridge, Failure, _finite
+from ._common import AttrDict, Handle
 from .errors import CallbackError, FesdError, OutputShapeError
 from .integrator import _events, build_model_struct, fill_settings, step_data
 from .model import Model
@@ -84,22 +85,8 @@ class _Fn:
             du = _asmat(du, (n, nu), role + " (d/du)") if want_u else None
             return dx, du
         h0 = self.owner.fd_step
-        dx = np.empty((n, nx))
-        for j in range(nx):
-            xp, xm = np.array(x), np.array(x)
-            h = h0 * max(1.0, abs(x[j]))
-            xp[j] += h
-            xm[j] -= h
-            dx[:, j] = (self._value(t, xp, u) - self._value(t, xm, u)) / (xp[j] - xm[j])
-        du = None
-        if want_u:
-            du = np.empty((n, nu))
-            for j in range(nu):
-                up, um = np.array(u), np.array(u)
-                h = h0 * max(1.0, abs(u[j]))
-                up[j] += h
-                um[j] -= h
-                du[:, j] = (self._value(t, x, up) - self._value(t, x, um)) / (up[j] - um[j])
+        dx = _central(lambda xx: self._value(t, xx, u), x, n, h0)
+        du = _central(lambda uu: self._value(t, x, uu), u, n, h0) if want_u else None
         return dx, du
 
     def _call(self, t, x, u, val, dx, du, user):
@@ -127,6 +114,19 @@ class _Fn:
             return 0
         except BaseException as e:  # noqa: B902 - reported by solve() after the C call
             return o._fail(self.role, t, x, e)
+
+
+def _central(f, z, n, h0):
+    """(n, len(z)) central differences of f at z, steps h0 max(1, |z_j|) (the divisor is the
+    step as represented: (z_j + h) - (z_j - h))."""
+    d = np.empty((n, len(z)))
+    for j in range(len(z)):
+        zp, zm = np.array(z), np.array(z)
+        h = h0 * max(1.0, abs(z[j]))
+        zp[j] += h
+        zm[j] -= h
+        d[:, j] = (f(zp) - f(zm)) / (zp[j] - zm[j])
+    return d
 
 
 def _asvec(res, n, role):
@@ -182,7 +182,7 @@ class OcpInterval:
     events: list
 
 
-class OcpResult(dict):
+class OcpResult(AttrDict):
     """Result of OCP.solve (a dict with attribute access, as fesd.OdeResult).
 
     status (0 or a negative fesd status), status_name, message (the library's status string),
@@ -199,18 +199,8 @@ class OcpResult(dict):
     evaluate the model at a non-finite iterate and recover).
     """
 
-    def __getattr__(self, name):
-        try:
-            return self[name]
-        except KeyError as e:
-            raise AttributeError(name) from e
-
-    __setattr__ = dict.__setitem__
-
-    def __repr__(self):
-        keys = ("status_name", "message", "objective", "iterations", "integrations", "stationarity_rel",
-                "feasibility", "complementarity", "time_total")
-        return "OcpResult(\n" + "\n".join(f"  {k}: {self.get(k)!r}" for k in keys) + "\n)"
+    _REPR_KEYS = ("status_name", "message", "objective", "iterations", "integrations", "stationarity_rel",
+                  "feasibility", "complementarity", "time_total")
 
     def summary(self):
         """A few lines: status, objective, KKT residuals, work."""
@@ -250,7 +240,7 @@ def _ptr(a):
 # ---------------------------------------------------------------------------------------------
 # the problem
 # ---------------------------------------------------------------------------------------------
-class OCP:
+class OCP(Handle):
     """Discretised optimal control problem (fesd_ocp_problem) and its SQP solver.
 
     model: fesd.Model (dense: no sparsity); n_ctrl: control intervals N; t0 < tf; x0 (nx,);
@@ -279,6 +269,8 @@ class OCP:
     print). Values are checked by the library: an invalid one raises FesdError
     (FESD_ERR_INVALID_ARG) from the constructor; an unknown name raises TypeError.
     """
+
+    _HANDLE, _FREE, _WHAT = "_o", "fesd_ocp_free", "OCP"
 
     def __init__(self, model, n_ctrl, t0, tf, x0, *, x0_lb=None, x0_ub=None, x_lb=None, x_ub=None, u_lb=None,
                  u_ub=None, lagrange=None, lagrange_jac=None, lagrange_lsq=None, lagrange_lsq_jac=None,
@@ -434,28 +426,6 @@ class OCP:
         nv, ne, ni = ctypes.c_int(), ctypes.c_int(), ctypes.c_int()
         _lib.lib.fesd_ocp_dims(self._o, _byref(nv), _byref(ne), _byref(ni))
         self.n_var, self.n_eq, self.n_ineq = nv.value, ne.value, ni.value
-
-    # ---- lifetime ----
-    def close(self):
-        if self._o:
-            _lib.lib.fesd_ocp_free(_byref(self._o))
-
-    def __del__(self):
-        try:
-            self.close()
-        except Exception:  # interpreter shutdown
-            pass
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
-
-    def _ptr(self):
-        if not self._o:
-            raise ValueError("the OCP is closed")
-        return self._o
 
     # ---- failures ----
     def _log(self, user, msg):
