@@ -120,6 +120,8 @@ struct fesd_integrator {
    * stage Newton (its result is then a fixed point of it); z0_fixed: so did the one that made
    * z0 in fesd__initial_guess (start_solve need not repeat it on an unchanged z0) */
   int guess_fixed, z0_fixed;
+  int full_check;   /* tests: always check the start solve on the whole step system (step.c) */
+  long n_certified; /* start solves certified on their V rows (step.c), since fesd_create */
   int last_sw, last_iter; /* the last accepted step: a switch step?, its iterations (stats) */
   int exit_pinned; /* the accepted sub-step's exits are pinned (exit rows on the plan path) */           /* the step started on a surface that the fields on both sides leave */
   /* the switch plan of the current (sub)step and the active set after each switch (rows of

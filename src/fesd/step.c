@@ -213,6 +213,44 @@ int fesd__fixed_solve(fesd_integrator *it, double *z, int max_iter, int slow_ite
   return FESD_OK;
 }
 
+/* A guess that stage Newton solved (every element) with one active mode per subsystem and
+ * no look-ahead stage satisfies every row of the step system but the V rows by construction
+ * (fesd__consistent_guess): theta is 0/1 and the S rows hold exactly, mu is the active mode's
+ * indicator so the active lambdas and boundary LP values are 0 exactly, the other lambdas and
+ * x_{n+1} are computed from the G and X rows (residuals of a few eps relative to the rows'
+ * weights), the lengths are equal and the cross-complementarity rows are off. So the step is
+ * checked on its V rows alone, with the solve's weights: what the solver's residual check
+ * would find to round-off, without its evaluation of the whole system (an ordinary step,
+ * oscillator s = 5: 6.3k of 60.7k instructions). Returns 1 when certified (info updated). */
+static int certified(fesd_integrator *it, fesd_step_info *info) {
+  fesd__system *S = &it->sys;
+  const fesd__model *m = S->model;
+  if (it->full_check || S->look) return 0;
+  for (int k = 0; k < S->nsys; k++) {
+    int cnt = 0;
+    for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) cnt += it->act0[i] != 0;
+    if (cnt != 1) return 0;
+  }
+  if (fesd__rows_active(it, it->act, it->bmode, it->exit_mode) || fesd__system_weights(S, it->z)) return 0;
+  const double *z = it->z, *w = S->wraw;
+  double res = 0, *g = S->tmp;
+  for (int n = 0; n < S->N; n++)
+    for (int j = 0; j < S->s; j++) {
+      const double *v = z + fesd__v(S, n, j), *th = z + fesd__th(S, n, j);
+      const fesd__point_eval *pe = &S->pe[n * S->s + j];
+      const int rV = S->rel[n] + j * S->rs;
+      memcpy(g, v, (size_t)S->nx * sizeof(double));
+      for (int i = 0; i < S->nth; i++)
+        if (th[i] != 0.0) fesd__F_axpy(m, pe, i, -th[i], g);
+      for (int r = 0; r < S->nx; r++) res = fmax(res, fabs(g[r] * w[rV + r]));
+    }
+  if (!(res <= it->set.newton_tol)) return 0;
+  info->residual = res;
+  info->solves++;
+  it->n_certified++;
+  return 1;
+}
+
 /* The start's active set at every stage of the N_FE layout, from the warm start z0. */
 int fesd__start_solve(fesd_integrator *it, fesd_step_info *info) {
   fesd__system *S = &it->sys;
@@ -224,6 +262,7 @@ int fesd__start_solve(fesd_integrator *it, fesd_step_info *info) {
    * unchanged (bit for bit), a second consistent guess would return it unchanged */
   const int same = it->z0_fixed && !memcmp(it->z, it->z0, (size_t)S->n * sizeof(double));
   it->z0_fixed = 0;
+  if (same && certified(it, info)) return FESD_OK;
   int st = same ? FESD_OK : fesd__consistent_guess(it, it->z);
   if (st) return st;
   return fesd__fixed_solve(it, it->z, it->set.max_iter_first, 0, info);
