@@ -314,6 +314,7 @@ int fesd_set_state(fesd_integrator *it, double t0, const double *x0, const doubl
   if (it->wrap.td) it->x[it->nxu] = t0; /* time as the last state */
   it->have_ws = 0;
   it->have_prev_theta = 0;
+  it->gn_warm = 0; /* a new integration takes the stage Newton's path of a new object */
   fesd__system_reset_refs(&it->sys);
   if (it->set.sensitivities) {
     memset(it->Sx, 0, (size_t)it->nx * it->nx * sizeof(double));
@@ -345,6 +346,7 @@ void fesd__save(fesd_integrator *it, fesd__saved *b) {
   b->have_prev_theta = it->have_prev_theta;
   b->n_el = it->n_el;
   b->n_events = it->n_events;
+  b->gn_warm = it->gn_warm;
   memcpy(b->x, it->x, nx * sizeof(double));
   memcpy(b->lam, it->lam00, nth * sizeof(double));
   memcpy(b->th, it->theta_prev, nth * sizeof(double));
@@ -363,6 +365,7 @@ void fesd__load(fesd_integrator *it, const fesd__saved *b) {
   it->have_prev_theta = b->have_prev_theta;
   it->n_el = b->n_el;
   it->n_events = b->n_events;
+  it->gn_warm = b->gn_warm;
   memcpy(it->x, b->x, nx * sizeof(double));
   memcpy(it->lam00, b->lam, nth * sizeof(double));
   memcpy(it->theta_prev, b->th, nth * sizeof(double));

@@ -63,6 +63,7 @@ typedef struct {
 typedef struct {
   double t, t_c, *x, *lam, *th, *blk, *Sx, *Su, *ldp;
   int have_ws, have_prev_theta, n_el, n_events;
+  int gn_warm; /* the stage Newton's choice of start (a retried step takes the same path) */
 } fesd__saved;
 
 struct fesd_integrator {
@@ -94,6 +95,7 @@ struct fesd_integrator {
   double *gn, *gn_key, *gn_memo;
   int gn_memo_ok;
   int gn_full_at; /* the Newton pass that converged last (evaluated in full: stage_newton.c) */
+  int gn_warm;    /* the warm start solved the last element as it was: check it first */
   double *fil_th;         /* nth: multipliers of an alternative (verify.c) */
   double *slide_tmp;      /* 2 nx: the coupled sliding multipliers (fesd__stage_theta) */
   unsigned char *fil_a;   /* nth: its active flags */

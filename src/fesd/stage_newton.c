@@ -13,13 +13,12 @@
 /* Key of the stage matrix of element n (h, then J_j = sum_i theta_j,i df_i/dx at x_n for each
  * stage j on the union pattern) into it->gn_key; its LU is in it->gn when it equals the key
  * of the factorization kept (it->gn_memo). Returns 1 on a failed evaluation. */
-static int stage_key(fesd_integrator *it, const double *z, int n, const double *xn, double h, double tn) {
+static int stage_key(fesd_integrator *it, const double *z, int n, const double *xn, double h, double tn,
+                     fesd__point_eval *pj) {
   fesd__system *S = &it->sys;
   fesd__model *m = &it->model;
   const int nnz = m->pf_nnz;
-  fesd__point_eval pj = {0};
-  pj.dFdx = it->pscr.dFdx;
-  if (fesd__model_eval(m, tn, xn, S->u, &pj)) return 1;
+  if (fesd__model_eval(m, tn, xn, S->u, pj)) return 1;
   it->gn_key[0] = h;
   for (int j = 0; j < S->s; j++) {
     const double *th = z + fesd__th(S, n, j), *tp = j > 0 ? z + fesd__th(S, n, j - 1) : NULL;
@@ -29,7 +28,7 @@ static int stage_key(fesd_integrator *it, const double *z, int n, const double *
     if (same)
       for (int e = 0; e < nnz; e++) J[e] = J[e - nnz];
     else
-      fesd__Jth(m, &pj, th, J);
+      fesd__Jth(m, pj, th, J);
   }
   return 0;
 }
@@ -69,8 +68,10 @@ static int stage_factor(fesd_integrator *it) {
  * in 1-3 iterations from the warm start, also for stiff fields, where the fixed-point sweeps
  * need 8-16 passes or diverge. Returns 0 when the stage residual is at round-off level
  * (1e-14 of the stage derivatives), 1 otherwise (v is then left as it was: the sweeps take
- * over). The first residual is checked before any Jacobian: a converged guess costs s
- * evaluations. The stage states of the last pass stay in S->X + (n s + j) nx. */
+ * over). A warm start that solved the last element as it was (it->gn_warm: a field constant
+ * in x) is checked before any Jacobian and costs s evaluations when it holds; otherwise
+ * Newton starts from V = 0 (below). The stage states of the last pass stay in
+ * S->X + (n s + j) nx. */
 int fesd__stage_newton(fesd_integrator *it, double *z, int n, const double *xn, double h, double tn) {
   fesd__system *S = &it->sys;
   fesd__model *m = &it->model;
@@ -80,6 +81,31 @@ int fesd__stage_newton(fesd_integrator *it, double *z, int n, const double *xn, 
   for (int j = 0; j < s; j++) memcpy(V0 + j * nx, z + fesd__v(S, n, j), (size_t)nx * sizeof(double));
   double gprev = INFINITY;
   int factored = 0;
+  fesd__point_eval pj = {0};
+  pj.dFdx = it->pscr.dFdx;
+  const int predict = !it->gn_warm;
+  if (predict) {
+    /* Unless the warm start solved the last element as it was: start with the Newton step
+     * from V = 0, where every stage point is x_n, so its residual is -F(x_n) theta_j and its
+     * Jacobian the key's (one evaluation at x_n instead of s at the warm start's stage points;
+     * exact for a field linear in x, and O(h^2) off for a smooth one where the warm start,
+     * the last stage's v, is O(h) off). */
+    pj.F = it->pscr.F;
+    if (stage_key(it, z, n, xn, h, tn, &pj) || stage_factor(it)) return 1;
+    factored = 1;
+    for (int j = 0; j < s; j++) {
+      const double *th = z + fesd__th(S, n, j);
+      double *g = G + j * nx;
+      memset(g, 0, (size_t)nx * sizeof(double));
+      for (int i = 0; i < nth; i++)
+        if (th[i] != 0.0) fesd__F_axpy(m, &pj, i, -th[i], g);
+    }
+    fesd__dense_lu_solve(q, it->gn, it->gn_piv, G);
+    for (int j = 0; j < s; j++) {
+      double *v = z + fesd__v(S, n, j);
+      for (int r = 0; r < nx; r++) v[r] = -G[j * nx + r];
+    }
+  }
   for (int iter = 0; iter < 6; iter++) {
     double gmax = 0, vmax = 0;
     /* the pass that converged last time is evaluated in full into the stage records: when it
@@ -112,11 +138,15 @@ int fesd__stage_newton(fesd_integrator *it, double *z, int n, const double *xn, 
     if (!(gmax <= 1e300)) break; /* NaN or overflow: the sweeps decide */
     if (gmax <= 1e-14 * vmax || gmax == 0.0) {
       it->gn_full_at = iter;
+      /* a prediction that reproduced the warm start (a constant field): check it first next */
+      it->gn_warm = iter == 0 && (!predict || !memcmp(V0, z + fesd__v(S, n, 0), (size_t)nx * sizeof(double)));
+      for (int j = 1; j < s && it->gn_warm; j++)
+        it->gn_warm = !memcmp(V0 + j * nx, z + fesd__v(S, n, j), (size_t)nx * sizeof(double));
       return 0;
     }
     if (gmax > 0.5 * gprev) break; /* not converging like Newton */
     gprev = gmax;
-    if (!factored && (stage_key(it, z, n, xn, h, tn) || stage_factor(it))) break;
+    if (!factored && (stage_key(it, z, n, xn, h, tn, &pj) || stage_factor(it))) break;
     factored = 1;
     fesd__dense_lu_solve(q, it->gn, it->gn_piv, G); /* G <- M^{-1} G */
     for (int j = 0; j < s; j++) {
