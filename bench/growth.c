@@ -14,7 +14,8 @@
  * Chain Pareto (chain_pareto.csv): n = 64, T = 4, FESD against the standard method (same
  * Radau IIA s = 2, 3, N_FE = 2, same solver), h = 0.2 / 2^k; error at T against Lobatto IIIC
  * s = 4 at h = 0.2 / 32; CPU ratio at equal error.
- *   bench_growth [--quick] [OUTDIR]   (--quick: n = 8 .. 128 (switching: .. 64), short timings) */
+ *   bench_growth [--quick] [--pareto] [OUTDIR]   (--quick: n = 8 .. 128 (switching: .. 64), short
+ *                                                  timings; --pareto: the chain Pareto alone) */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -157,7 +158,12 @@ static int chain_pareto(void) {
 }
 
 int main(int argc, char **argv) {
-  if (bench_init(argc, argv, "bench_growth [--quick] [OUTDIR]")) return 2;
+  int pareto_only = 0, argn = 1;
+  for (int i = 1; i < argc; i++) /* --pareto is this program's own option */
+    if (!strcmp(argv[i], "--pareto")) pareto_only = 1;
+    else argv[argn++] = argv[i];
+  if (bench_init(argn, argv, "bench_growth [--quick] [--pareto] [OUTDIR]")) return 2;
+  if (pareto_only) return chain_pareto();
   FILE *out = bench_csv("growth.csv", "series,n,nx,unknowns_per_step,ms_per_step,"
                                       "newton_iter_per_step,factorizations_per_step");
   if (!out) return 1;
