@@ -18,7 +18,15 @@ static int stage_key(fesd_integrator *it, const double *z, int n, const double *
   fesd__system *S = &it->sys;
   fesd__model *m = &it->model;
   const int nnz = m->pf_nnz;
-  if (fesd__model_eval(m, tn, xn, S->u, pj)) return 1;
+  /* x_n of a later element is the last stage point of the one before when c_s = 1: its
+   * record (evaluated in full by the guess) holds the fields and Jacobians there */
+  const fesd__point_eval *rec = n > 0 ? fesd__system_record(S, n * S->s - 1, tn, xn, 2) : NULL;
+  if (rec) {
+    if (pj->F) memcpy(pj->F, rec->F, (size_t)m->nF * sizeof(double));
+    memcpy(pj->dFdx, rec->dFdx, (size_t)m->ndF * sizeof(double));
+  } else if (fesd__model_eval(m, tn, xn, S->u, pj)) {
+    return 1;
+  }
   it->gn_key[0] = h;
   for (int j = 0; j < S->s; j++) {
     const double *th = z + fesd__th(S, n, j), *tp = j > 0 ? z + fesd__th(S, n, j - 1) : NULL;
