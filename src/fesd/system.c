@@ -352,7 +352,7 @@ int fesd__system_init(fesd__system *S, fesd__model *m, const fesd_tableau *tab, 
   S->KG = malloc((size_t)N * s * nth * sizeof(double));
   S->Juth = malloc((size_t)N * s * nx * nu1 * sizeof(double));
   S->lam00_dp = malloc((sens ? (size_t)nth * (nx + nu) : 1) * sizeof(double)); /* O(n^2) */
-  S->tmp = malloc((size_t)(4 * nx + nth) * sizeof(double));
+  S->tmp = malloc((size_t)(4 * nx + 2 * nth) * sizeof(double));
   S->pc_z = malloc((size_t)N * S->eb * sizeof(double));
   S->pc_xu = malloc((size_t)(nx + nu) * sizeof(double));
   S->pt_X = malloc((size_t)N * s * nx * sizeof(double) + 1);

@@ -57,7 +57,7 @@ typedef struct {
   double *KG;   /* grad g_i . K_j per stage point (nth) */
   double *Juth; /* sum_i theta_i dF_i/du per stage point, N*s blocks nx x nu */
   double *lam00_dp; /* d lambda00 / d(x_start, u): nth x (nx + nu) */
-  double *tmp;  /* 4 nx + nth */
+  double *tmp;  /* 4 nx + 2 nth */
   /* row weights (n_raw of the largest layout), indicator weights per subsystem (wG) and
    * per stacked mode (wth = wG of its subsystem) */
   double *wraw, *wG, *wth;

@@ -34,61 +34,69 @@ static double amax(double a, double b) { return a > b ? a : b; }
 int fesd__system_weights(fesd__system *S, const double *z) {
   int st = fesd__system_points(S, z, 1);
   if (st) return st;
-  const int N = S->N, s = S->s, nx = S->nx, nth = S->nth, nsys = S->nsys;
+  const int N = S->N, s = S->s, nx = S->nx, nth = S->nth, nsys = S->nsys, sb = S->sb, pnz = S->model->pf_nnz;
   const fesd__model *m = S->model;
-  double *w = S->wraw, *xi = S->tmp, *acc = S->tmp + nx;
-  double *mX = S->magX, *mV = S->magV, *mf = S->tmp + 3 * nx; /* mf: max_i |f_i,r| */
+  /* locals and restrict: the outputs do not alias S's fields (T, the tableau), which the
+   * loops would otherwise reload after every store */
+  const double T = S->T;
+  const int *restrict pf_r = m->pf_r, *restrict pf_c = m->pf_c;
+  double *restrict w = S->wraw, *restrict xi = S->tmp, *restrict acc = S->tmp + nx;
+  double *restrict mX = S->magX, *restrict mV = S->magV, *restrict mf = S->tmp + 3 * nx; /* mf: max_i |f_i,r| */
+  double *restrict wG = S->wG;
   for (int r = 0; r < nx; r++) mX[r] = mV[r] = mf[r] = 0;
   for (int p = 0; p < N * s; p++)
     for (int i = 0; i < nth; i++) {
-      const int k = m->sys_of[i];
+      const int k = m->sys_of[i], nr = m->nr[k], *rows = m->rows[k];
       const double *f = S->pe[p].F + m->Foff[i];
-      for (int q = 0; q < m->nr[k]; q++) mf[m->rows[k][q]] = amax(mf[m->rows[k][q]], fabs(f[q]));
+      for (int q = 0; q < nr; q++) mf[rows[q]] = amax(mf[rows[q]], fabs(f[q]));
     }
-  double *gf = S->tmp + 4 * nx; /* per subsystem: sum_c |dg/dx_c| T mf_c (max over modes, points) */
+  double *restrict gf = S->tmp + 4 * nx; /* per subsystem: sum_c |dg/dx_c| T mf_c (max over modes, points) */
   for (int k = 0; k < nsys; k++) gf[k] = 0;
   for (int p = 0; p < N * s; p++)
     for (int k = 0; k < nsys; k++) {
-      const int nf = m->nf[k];
+      const int nf = m->nf[k], nc = m->ncol[k], *cols = m->cols[k];
       const double *blk = S->pe[p].dgdx + m->dgoff[k];
+      double gk = gf[k];
       for (int li = 0; li < nf; li++) {
         double a = 0;
-        for (int c = 0; c < m->ncol[k]; c++) a += fabs(blk[(size_t)c * nf + li]) * S->T * mf[m->cols[k][c]];
-        gf[k] = amax(gf[k], a);
+        for (int c = 0; c < nc; c++) a += fabs(blk[(size_t)c * nf + li]) * T * mf[cols[c]];
+        gk = amax(gk, a);
       }
+      gf[k] = gk;
     }
-  for (int k = 0; k < nsys; k++) S->wG[k] = 0; /* indicator sizes first */
+  for (int k = 0; k < nsys; k++) wG[k] = 0; /* indicator sizes first */
   for (int n = 0; n < N; n++) {
-    const double h = z[S->ho[n]], *xn = n == 0 ? S->x0 : z + S->xo[n - 1];
+    const double h = z[S->ho[n]], *xn = n == 0 ? S->x0 : z + S->xo[n - 1], *ve = z + S->el[n];
     for (int j = 0; j < s; j++) {
       const int p = n * s + j, rV = S->rel[n] + j * S->rs, rG = rV + nx, rS = rG + nth;
       const fesd__point_eval *pe = &S->pe[p];
-      const double *v = z + fesd__v(S, n, j), *th = z + fesd__th(S, n, j);
-      const double *la = z + fesd__la(S, n, j), *mu = z + fesd__mu(S, n, j);
+      const double *v = ve + j * sb, *th = v + nx, *la = th + nth, *mu = la + nth;
+      const double *Aj = S->tab.A[j];
       for (int c = 0; c < nx; c++) {
         double a = fabs(xn[c]);
-        for (int l = 0; l < s; l++) a += h * fabs(S->tab.A[j][l] * z[fesd__v(S, n, l) + c]);
+        for (int l = 0; l < s; l++) a += h * fabs(Aj[l] * ve[l * sb + c]);
         xi[c] = a;
         acc[c] = fabs(v[c]);
       }
       for (int i = 0; i < nth; i++) {
         if (th[i] == 0.0) continue;
-        const int k = m->sys_of[i];
-        const double *f = pe->F + m->Foff[i];
-        for (int q = 0; q < m->nr[k]; q++) acc[m->rows[k][q]] += fabs(th[i] * f[q]);
+        const int k = m->sys_of[i], nr = m->nr[k], *rows = m->rows[k];
+        const double *f = pe->F + m->Foff[i], t = th[i];
+        for (int q = 0; q < nr; q++) acc[rows[q]] += fabs(t * f[q]);
       }
-      const double *J = S->Jth + (size_t)p * m->pf_nnz;
-      double *jx = acc + nx; /* sum_c |J_rc| xi_c */
-      memset(jx, 0, (size_t)nx * sizeof(double));
-      for (int q = 0; q < m->pf_nnz; q++) jx[m->pf_r[q]] += fabs(J[q]) * xi[m->pf_c[q]];
+      const double *J = S->Jth + (size_t)p * pnz;
+      double *restrict jx = acc + nx; /* sum_c |J_rc| xi_c */
+      for (int r = 0; r < nx; r++) jx[r] = 0;
+      for (int q = 0; q < pnz; q++) jx[pf_r[q]] += fabs(J[q]) * xi[pf_c[q]];
+      double *restrict wv = w + rV;
       for (int r = 0; r < nx; r++) {
-        w[rV + r] = amax(acc[r], jx[r]);
-        mV[r] = amax(mV[r], w[rV + r]);
+        wv[r] = amax(acc[r], jx[r]);
+        mV[r] = amax(mV[r], wv[r]);
       }
       for (int k = 0; k < nsys; k++) {
         const int nf = m->nf[k], off = m->th_off[k], nc = m->ncol[k], *cols = m->cols[k];
         const double *blk = pe->dgdx + m->dgoff[k], amu = fabs(mu[k]);
-        double wk = S->wG[k];
+        double wk = wG[k];
         for (int li = 0; li < nf; li++) {
           double a = 0;
           for (int c = 0; c < nc; c++) a += fabs(blk[(size_t)c * nf + li]) * xi[cols[c]];
@@ -97,7 +105,7 @@ int fesd__system_weights(fesd__system *S, const double *z) {
           w[rG + i] = a;
           wk = amax(wk, a);
         }
-        S->wG[k] = wk;
+        wG[k] = wk;
         w[rS + k] = 1.0;
       }
     }
@@ -120,53 +128,58 @@ int fesd__system_weights(fesd__system *S, const double *z) {
         w[rM + k] = mk; /* theta' LB: units of the indicators */
       }
     }
-    const double *x1 = z + S->xo[n];
+    const double *x1 = z + S->xo[n], *b = S->tab.b;
+    double *restrict wx = w + S->rx[n];
     for (int r = 0; r < nx; r++) {
       double a = 0;
-      for (int j = 0; j < s; j++) a += fabs(S->tab.b[j] * z[fesd__v(S, n, j) + r]);
-      const int row = S->rx[n] + r;
-      w[row] = amax(amax(fabs(xn[r]), fabs(x1[r])), h * a);
-      mX[r] = amax(mX[r], w[row]);
+      for (int j = 0; j < s; j++) a += fabs(b[j] * ve[j * sb + r]);
+      wx[r] = amax(amax(fabs(xn[r]), fabs(x1[r])), h * a);
+      mX[r] = amax(mX[r], wx[r]);
     }
   }
-  /* invert, with the floors of each component and subsystem */
-  double *fX = xi, *fV = acc; /* floors (scratch reused) */
+  /* invert, with the floors of each component, subsystem and mode */
+  double *restrict fX = xi, *restrict fV = acc, *restrict fth = S->tmp + 4 * nx + nth; /* scratch reused */
   for (int r = 0; r < nx; r++) {
-    fX[r] = amax(ATOL_REL * amax(S->refX[r], S->T * mf[r]), FLOOR);
+    fX[r] = amax(ATOL_REL * amax(S->refX[r], T * mf[r]), FLOOR);
     fV[r] = amax(ATOL_REL * amax(S->refV[r], mf[r]), FLOOR);
   }
   for (int k = 0; k < nsys; k++) {
     const double fG = amax(ATOL_REL * amax(S->refG[k], gf[k]), FLOOR);
-    S->magG[k] = S->wG[k];
-    S->wG[k] = 1.0 / amax(S->wG[k], fG);
+    S->magG[k] = wG[k];
+    wG[k] = 1.0 / amax(wG[k], fG);
     gf[k] = fG;
   }
-  for (int i = 0; i < nth; i++) S->wth[i] = S->wG[m->sys_of[i]];
+  double *restrict wth = S->wth;
+  for (int i = 0; i < nth; i++) {
+    wth[i] = wG[m->sys_of[i]];
+    fth[i] = gf[m->sys_of[i]];
+  }
   for (int n = 0; n < N; n++) {
     for (int j = 0; j < s; j++) {
-      const int rV = S->rel[n] + j * S->rs, rG = rV + nx;
-      for (int r = 0; r < nx; r++) w[rV + r] = 1.0 / amax(w[rV + r], fV[r]);
-      for (int i = 0; i < nth; i++) w[rG + i] = 1.0 / amax(w[rG + i], gf[m->sys_of[i]]);
+      double *restrict wv = w + S->rel[n] + j * S->rs, *restrict wg = wv + nx;
+      for (int r = 0; r < nx; r++) wv[r] = 1.0 / amax(wv[r], fV[r]);
+      for (int i = 0; i < nth; i++) wg[i] = 1.0 / amax(wg[i], fth[i]);
     }
     if (S->lbo[n] >= 0) {
       const int rL = S->rlb[n], rM = rL + nth;
-      for (int i = 0; i < nth; i++) w[rL + i] = 1.0 / amax(w[rL + i], gf[m->sys_of[i]]);
+      for (int i = 0; i < nth; i++) w[rL + i] = 1.0 / amax(w[rL + i], fth[i]);
       for (int k = 0; k < nsys; k++) w[rM + k] = 1.0 / amax(w[rM + k], gf[k]);
     }
-    for (int r = 0; r < nx; r++) w[S->rx[n] + r] = 1.0 / amax(w[S->rx[n] + r], fX[r]);
+    double *restrict wx = w + S->rx[n];
+    for (int r = 0; r < nx; r++) wx[r] = 1.0 / amax(wx[r], fX[r]);
   }
   for (int k = 1; k < N; k++) {
-    w[fesd__rowH(S, k)] = 1.0 / S->T;
+    w[fesd__rowH(S, k)] = 1.0 / T;
     w[fesd__rowC(S, k)] = 1.0; /* its terms are weighted by wth: dimensionless */
   }
-  w[S->rT] = 1.0 / S->T;
-  for (int n = 0; n < N; n++)
-    for (int j = 0; j < s; j++)
-      for (int i = 0; i < nth; i++) {
-        const int p = fesd__pair(S, n, j, i);
-        w[S->n_eq + p] = 1.0;
-        w[S->n_eq + S->n_pair + p] = S->wth[i];
-      }
+  w[S->rT] = 1.0 / T;
+  /* pair rows (fesd__pair: stage points in order, nth pairs each): theta 1, lambda wth */
+  double *restrict wa = w + S->n_eq, *restrict wb = wa + S->n_pair;
+  for (int p = 0; p < N * s * nth; p += nth)
+    for (int i = 0; i < nth; i++) {
+      wa[p + i] = 1.0;
+      wb[p + i] = wth[i];
+    }
   return FESD_OK;
 }
 
