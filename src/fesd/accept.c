@@ -8,19 +8,27 @@
 
 /* lambda00 = g(x) - min g e per subsystem, and (when sensitivities are on) its derivative
  * w.r.t. (x, u) using the argmin (ties: the mode with the largest theta_prev). */
-int fesd__update_lambda00(fesd_integrator *it, const double *x, const double *u, int deriv) {
+int fesd__update_lambda00(fesd_integrator *it, const double *x, const double *u, int deriv,
+                          const fesd__point_eval *rec) {
   fesd__model *m = &it->model;
   const int nx = m->nx, nu = m->nu, nth = m->nth;
   fesd__point_eval pe = {0};
   pe.g = it->gbuf;
   double *dg = it->sys.lam00_dp; /* nth x (nx+nu) column-major */
-  double *dgdu = it->pscr.dgdu, *t = it->vtmp;
-  if (deriv) {
-    pe.dgdx = it->pscr.dgdx;
-    pe.dgdu = nu > 0 ? dgdu : NULL;
+  const double *dgdu = it->pscr.dgdu;
+  double *t = it->vtmp;
+  if (rec) { /* an evaluation at (it->t, x) made in this step */
+    memcpy(it->gbuf, rec->g, (size_t)nth * sizeof(double));
+    pe.dgdx = rec->dgdx;
+    dgdu = rec->dgdu;
+  } else {
+    if (deriv) {
+      pe.dgdx = it->pscr.dgdx;
+      pe.dgdu = nu > 0 ? it->pscr.dgdu : NULL;
+    }
+    int st = fesd__model_eval(m, it->t, x, u, &pe);
+    if (st) return st;
   }
-  int st = fesd__model_eval(m, it->t, x, u, &pe);
-  if (st) return st;
   for (int k = 0; k < m->nsys; k++) {
     int imin = m->th_off[k];
     for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) {
@@ -387,7 +395,10 @@ int fesd__accept(fesd_integrator *it, const double *z, const double *u, double T
   memcpy(it->x, z + S->xo[N - 1], (size_t)nx * sizeof(double));
   memcpy(it->theta_prev, z + fesd__th(S, N - 1, s - 1), (size_t)nth * sizeof(double));
   it->have_prev_theta = 1;
-  if ((st = fesd__update_lambda00(it, it->x, u, it->set.sensitivities))) return st;
+  /* x is the last stage point when c_s = 1: its record (this step's) holds g there */
+  const int need = it->set.sensitivities ? (it->nu > 0 ? 3 : 2) : 1;
+  const fesd__point_eval *rec = fesd__system_record(S, N * s - 1, it->t, it->x, need);
+  if ((st = fesd__update_lambda00(it, it->x, u, it->set.sensitivities, rec))) return st;
   memcpy(it->ws_blk, z + fesd__v(S, N - 1, s - 1), (size_t)S->sb * sizeof(double));
   it->have_ws = 1;
   return FESD_OK;

@@ -333,7 +333,7 @@ int fesd_set_state(fesd_integrator *it, double t0, const double *x0, const doubl
   it->ec_err_prev = 0;
   it->log_pool_n = 0;
   /* lambda00 = g(x0) - min g (paper Sec. 3.2.2), with its derivative for sensitivities */
-  int st = fesd__update_lambda00(it, it->x, u, it->set.sensitivities);
+  int st = fesd__update_lambda00(it, it->x, u, it->set.sensitivities, NULL);
   it->have_state = (st == FESD_OK);
   return st;
 }

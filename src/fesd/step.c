@@ -257,10 +257,19 @@ int fesd__start_solve(fesd_integrator *it, fesd_step_info *info) {
   for (int p = 0; p < S->N * S->s; p++) memcpy(it->act + (size_t)p * S->nth, it->act0, (size_t)S->nth);
   memset(it->bmode, 0, (size_t)(S->N + 1) * sizeof(int));
   memcpy(it->z, it->z0, (size_t)S->n * sizeof(double));
-  fesd__impose_active(it, it->z, it->act);
-  /* z0 came out of a consistent guess solved by stage Newton: if the active set left it
-   * unchanged (bit for bit), a second consistent guess would return it unchanged */
-  const int same = it->z0_fixed && !memcmp(it->z, it->z0, (size_t)S->n * sizeof(double));
+  /* z0 came out of a consistent guess solved by stage Newton: if the active set leaves it
+   * unchanged (bit for bit), a second consistent guess would return it unchanged. Every theta
+   * already the 0/1 indicator of act0 (an ordinary step) is left so by fesd__impose_active. */
+  int same = it->z0_fixed;
+  for (int n = 0; n < S->N && same; n++)
+    for (int j = 0; j < S->s && same; j++) {
+      const double *th = it->z + fesd__th(S, n, j);
+      for (int i = 0; i < S->nth && same; i++) same = th[i] == (it->act0[i] ? 1.0 : 0.0);
+    }
+  if (!same) {
+    fesd__impose_active(it, it->z, it->act);
+    same = it->z0_fixed && !memcmp(it->z, it->z0, (size_t)S->n * sizeof(double));
+  }
   it->z0_fixed = 0;
   if (same && certified(it, info)) return FESD_OK;
   int st = same ? FESD_OK : fesd__consistent_guess(it, it->z);

@@ -9,7 +9,10 @@
  * settings.max_splits). */
 int fesd__substep(fesd_integrator *it, const double *u, double T, int depth, fesd_step_info *info);
 /* lambda00 = g(x) - min g per subsystem (and d/d(x,u) into sys.lam00_dp when deriv). */
-int fesd__update_lambda00(fesd_integrator *it, const double *x, const double *u, int deriv);
+/* lambda00 at x (and its derivatives with deriv): from rec when it is an evaluation at
+ * (it->t, x) of this step, else evaluated. */
+int fesd__update_lambda00(fesd_integrator *it, const double *x, const double *u, int deriv,
+                          const fesd__point_eval *rec);
 /* Shared by the solve paths (step.c, step_std.c): a callback failure, NaN/Inf or no memory (no
  * other path can succeed); the solve with the per-stage active sets it->act from z; the solve
  * with the start's active set everywhere from the warm start; the standard method's step. */
