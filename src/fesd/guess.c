@@ -22,6 +22,7 @@ int fesd__consistent_guess(fesd_integrator *it, double *z) {
   pg.g = g;
   double tn = S->t0;
   it->guess_fixed = 1;
+  int full = 1; /* every stage point evaluated in full at the stage Newton's state */
   for (int n = 0; n < S->N; n++) {
     const double *xn = n == 0 ? S->x0 : z + S->xo[n - 1];
     double h = z[S->ho[n]];
@@ -82,6 +83,7 @@ int fesd__consistent_guess(fesd_integrator *it, double *z) {
        * failing Jacobian callback is reported by the solve, as without this) */
       const double tj = tn + S->tab.c[j] * h;
       const fesd__point_eval *pf = fesd__system_stage_eval(S, n * s + j, tj, Xj, 1);
+      full &= pf != NULL;
       if (pf) {
         memcpy(g, pf->g, (size_t)nth * sizeof(double));
       } else {
@@ -116,6 +118,7 @@ int fesd__consistent_guess(fesd_integrator *it, double *z) {
     }
     tn += h;
   }
+  if (it->guess_fixed && full && !S->bp && !S->look) fesd__system_points_adopt(S, z);
   return FESD_OK;
 }
 

@@ -167,6 +167,18 @@ int fesd__system_points(fesd__system *S, const double *z, int want_jac) {
   return FESD_OK;
 }
 
+void fesd__system_points_adopt(fesd__system *S, const double *z) {
+  const fesd__model *m = S->model;
+  if (points_cached(S, z, 1)) return;
+  for (int n = 0; n < S->N; n++)
+    for (int j = 0; j < S->s; j++) {
+      const int p = n * S->s + j;
+      fesd__Jth(m, &S->pe[p], z + fesd__th(S, n, j), S->Jth + (size_t)p * m->pf_nnz);
+    }
+  S->pc_hcol = 0;
+  S->pc_valid = 1;
+}
+
 /* JK and KG of every stage point (look-ahead KG: look_ahead) from the K_j that
  * fesd__system_points left in JK: only a Newton Jacobian has an h column, the row weights and
  * residuals of a converged guess need neither. */

@@ -122,9 +122,11 @@ int fesd__stage_newton(fesd_integrator *it, double *z, int n, const double *xn, 
     for (int j = 0; j < s; j++) {
       const double *v = z + fesd__v(S, n, j), *th = z + fesd__th(S, n, j), tj = tn + S->tab.c[j] * h;
       double *X = S->X + (size_t)(n * s + j) * nx; /* kept for the LP rows */
+      double *K = S->JK + (size_t)(n * s + j) * nx; /* K_j = sum_l a_jl v_l (fesd__system_points_adopt) */
       for (int r = 0; r < nx; r++) {
         double acc = 0;
         for (int l = 0; l < s; l++) acc += S->tab.A[j][l] * z[fesd__v(S, n, l) + r];
+        K[r] = acc;
         X[r] = xn[r] + h * acc;
       }
       const fesd__point_eval *pf = full ? fesd__system_stage_eval(S, n * s + j, tj, X, 1) : NULL;

@@ -238,11 +238,11 @@ static int certified(fesd_integrator *it, fesd_step_info *info) {
     for (int j = 0; j < S->s; j++) {
       const double *v = z + fesd__v(S, n, j), *th = z + fesd__th(S, n, j);
       const fesd__point_eval *pe = &S->pe[n * S->s + j];
-      const int rV = S->rel[n] + j * S->rs;
-      memcpy(g, v, (size_t)S->nx * sizeof(double));
+      const double *wv = w + S->rel[n] + j * S->rs;
+      for (int r = 0; r < S->nx; r++) g[r] = v[r];
       for (int i = 0; i < S->nth; i++)
         if (th[i] != 0.0) fesd__F_axpy(m, pe, i, -th[i], g);
-      for (int r = 0; r < S->nx; r++) res = fmax(res, fabs(g[r] * w[rV + r]));
+      for (int r = 0; r < S->nx; r++) res = fesd__fmax(res, fabs(g[r] * wv[r]));
     }
   if (!(res <= it->set.newton_tol)) return 0;
   info->residual = res;
@@ -254,7 +254,9 @@ static int certified(fesd_integrator *it, fesd_step_info *info) {
 /* The start's active set at every stage of the N_FE layout, from the warm start z0. */
 int fesd__start_solve(fesd_integrator *it, fesd_step_info *info) {
   fesd__system *S = &it->sys;
-  for (int p = 0; p < S->N * S->s; p++) memcpy(it->act + (size_t)p * S->nth, it->act0, (size_t)S->nth);
+  const size_t na = (size_t)S->N * S->s * S->nth; /* act0 at every stage: doubling copies */
+  memcpy(it->act, it->act0, (size_t)S->nth);
+  for (size_t c = (size_t)S->nth; c < na; c *= 2) memcpy(it->act + c, it->act, c < na - c ? c : na - c);
   memset(it->bmode, 0, (size_t)(S->N + 1) * sizeof(int));
   memcpy(it->z, it->z0, (size_t)S->n * sizeof(double));
   /* z0 came out of a consistent guess solved by stage Newton: if the active set leaves it

@@ -114,6 +114,11 @@ const fesd__point_eval *fesd__system_stage_eval(fesd__system *S, int p, double t
 const fesd__point_eval *fesd__system_record(const fesd__system *S, int p, double t, const double *X, int level);
 /* Nothing evaluated before is reused (the callbacks' user data may have changed). */
 void fesd__system_points_reset(fesd__system *S);
+/* Every stage point of z is recorded in full at the state fesd__system_points would compute
+ * (the guess's stage Newton: S->X, with K_j in JK), no boundary point and no look-ahead stage:
+ * forms the Jacobian sums and makes z the cached input, so the weights and the residual of z
+ * need no second pass over the points. */
+void fesd__system_points_adopt(fesd__system *S, const double *z);
 
 /* The outputs of fesd__system_points are no longer those of its last inputs. */
 static inline void fesd__system_points_stale(fesd__system *S) { S->pc_valid = 0; }
