@@ -202,11 +202,13 @@ static int active_modes(const fesd_integrator *it, const double *th, int k, int 
 /* ... and element n of z (active at any stage). */
 static int element_modes(const fesd_integrator *it, const double *z, int n, int k, int *out) {
   const fesd__model *m = &it->model;
+  const int s = it->s, sb = it->sys.sb, a = m->th_off[k], b = m->th_off[k + 1];
+  const double tol = it->set.active_tol, *th = z + fesd__th(&it->sys, n, 0); /* stage j: + j sb */
   int c = 0;
-  for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++)
-    for (int j = 0; j < it->s; j++)
-      if (z[fesd__th(&it->sys, n, j) + i] > it->set.active_tol) {
-        out[c++] = i - m->th_off[k];
+  for (int i = a; i < b; i++)
+    for (int j = 0; j < s; j++)
+      if (th[j * sb + i] > tol) {
+        out[c++] = i - a;
         break;
       }
   return c;

@@ -6,6 +6,17 @@
 
 #include "fesd/step.h"
 
+/* LP values of a stage block at the evaluated point: mu the theta-weighted indicator (so the
+ * modes theta marks active get lambda = 0 on the surface), lambda = g - mu. */
+static void stage_lp(const fesd__model *m, const double *g, const double *th, double *la, double *mu) {
+  for (int k = 0; k < m->nsys; k++) {
+    double num = 0, den = 0;
+    for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) num += th[i] * g[i], den += th[i];
+    mu[k] = den > 0 ? num / den : g[m->th_off[k]];
+  }
+  for (int i = 0; i < m->nth; i++) la[i] = g[i] - mu[m->sys_of[i]];
+}
+
 /* Make a guess consistent with its theta and h: a few fixed-point sweeps
  * v_j = F(X_j) theta_j with X_j = x_n + h sum_l a_jl v_l (exact for explicit methods after
  * s sweeps), then lambda, mu from the LP rows with mu the theta-weighted indicator (so the
@@ -84,20 +95,11 @@ int fesd__consistent_guess(fesd_integrator *it, double *z) {
       const double tj = tn + S->tab.c[j] * h;
       const fesd__point_eval *pf = fesd__system_stage_eval(S, n * s + j, tj, Xj, 1);
       full &= pf != NULL;
-      if (pf) {
-        memcpy(g, pf->g, (size_t)nth * sizeof(double));
-      } else {
+      if (!pf) {
         int st = fesd__model_eval(m, tj, Xj, S->u, &pg);
         if (st) return st;
       }
-      const double *th = z + fesd__th(S, n, j);
-      double *la = z + fesd__la(S, n, j), *mu = z + fesd__mu(S, n, j);
-      for (int k = 0; k < m->nsys; k++) {
-        double num = 0, den = 0;
-        for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) num += th[i] * g[i], den += th[i];
-        mu[k] = den > 0 ? num / den : g[m->th_off[k]];
-      }
-      for (int i = 0; i < nth; i++) la[i] = g[i] - mu[m->sys_of[i]];
+      stage_lp(m, pf ? pf->g : g, z + fesd__th(S, n, j), z + fesd__la(S, n, j), z + fesd__mu(S, n, j));
     }
     for (int r = 0; r < nx; r++) {
       double acc = 0;
@@ -107,14 +109,8 @@ int fesd__consistent_guess(fesd_integrator *it, double *z) {
     if (S->bp) {
       int st = fesd__model_g(m, tn + h, z + S->xo[n], S->u, g);
       if (st) return st;
-      const double *th = z + fesd__th(S, n, s - 1);
-      double *LB = z + S->lbo[n], *MB = LB + nth;
-      for (int k = 0; k < m->nsys; k++) {
-        double num = 0, den = 0;
-        for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) num += th[i] * g[i], den += th[i];
-        MB[k] = den > 0 ? num / den : g[m->th_off[k]];
-      }
-      for (int i = 0; i < nth; i++) LB[i] = g[i] - MB[m->sys_of[i]];
+      double *LB = z + S->lbo[n];
+      stage_lp(m, g, z + fesd__th(S, n, s - 1), LB, LB + nth);
     }
     tn += h;
   }
@@ -279,17 +275,6 @@ void fesd__stage_theta(fesd_integrator *it, const fesd__point_eval *pe, const un
         th[j] = tj;
       }
     }
-}
-
-/* LP values of a stage block at the evaluated point: mu the theta-weighted indicator (so the
- * modes theta marks active get lambda = 0 on the surface), lambda = g - mu. */
-static void stage_lp(const fesd__model *m, const double *g, const double *th, double *la, double *mu) {
-  for (int k = 0; k < m->nsys; k++) {
-    double num = 0, den = 0;
-    for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) num += th[i] * g[i], den += th[i];
-    mu[k] = den > 0 ? num / den : g[m->th_off[k]];
-  }
-  for (int i = 0; i < m->nth; i++) la[i] = g[i] - mu[m->sys_of[i]];
 }
 
 int fesd__regrid_guess(fesd_integrator *it, const double *zp, int Np, double *z) {

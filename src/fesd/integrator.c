@@ -229,7 +229,7 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   it->Su = dalloc(sx * nu, &fail);
   it->Dtmp = dalloc(settings->sensitivities ? (nx > nth ? nx : nth) * np : 1, &fail);
   it->Stmp = dalloc(settings->sensitivities ? nx * (nx > nu ? nx : nu) : 1, &fail);
-  it->gbuf = dalloc(nth + nx, &fail);
+  it->gbuf = dalloc(nth + (size_t)(FESD_RK_MAX_STAGES + 1) * nx, &fail); /* + the midpoint states */
   it->blk = dalloc((size_t)S->sb, &fail);
   it->vtmp = dalloc(2 * nx, &fail);
   it->ftot = dalloc(4 * nx, &fail); /* total field; first_step: two more states, weights */

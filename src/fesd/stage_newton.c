@@ -102,8 +102,14 @@ int fesd__stage_newton(fesd_integrator *it, double *z, int n, const double *xn, 
     if (stage_key(it, z, n, xn, h, tn, &pj) || stage_factor(it)) return 1;
     factored = 1;
     for (int j = 0; j < s; j++) {
-      const double *th = z + fesd__th(S, n, j);
+      const double *th = z + fesd__th(S, n, j), *tp = j > 0 ? z + fesd__th(S, n, j - 1) : NULL;
       double *g = G + j * nx;
+      int same = tp != NULL; /* the stage before has the same theta: its residual */
+      for (int i = 0; i < nth && same; i++) same = th[i] == tp[i];
+      if (same) {
+        memcpy(g, g - nx, (size_t)nx * sizeof(double));
+        continue;
+      }
       memset(g, 0, (size_t)nx * sizeof(double));
       for (int i = 0; i < nth; i++)
         if (th[i] != 0.0) fesd__F_axpy(m, &pj, i, -th[i], g);

@@ -52,23 +52,31 @@ void fesd__interior_setup(fesd_integrator *it) {
   }
 }
 
-void fesd__poly_state(const fesd_integrator *it, const double *z, int n, const double *w, double *x) {
+/* The states at count points of element n with weights w + q FESD_RK_MAX_STAGES, into
+ * x + q nx (the interior check's midpoints of an element at once). */
+static void poly_states(const fesd_integrator *it, const double *z, int n, const double *w, int count, double *x) {
   const fesd__system *S = &it->sys;
   const int nx = S->nx, s = S->s, sb = S->sb;
   const double *xn = n == 0 ? S->x0 : z + S->xo[n - 1], h = z[S->ho[n]], *ve = z + S->el[n];
-  if (nx <= s) { /* per component: x_n, then the stages in order (a short vector) */
-    for (int r = 0; r < nx; r++) {
-      double a = xn[r];
-      for (int j = 0; j < s; j++) a += h * w[j] * ve[j * sb + r];
-      x[r] = a;
+  for (int q = 0; q < count; q++, w += FESD_RK_MAX_STAGES, x += nx) {
+    if (nx <= s) { /* per component: x_n, then the stages in order (a short vector) */
+      for (int r = 0; r < nx; r++) {
+        double a = xn[r];
+        for (int j = 0; j < s; j++) a += h * w[j] * ve[j * sb + r];
+        x[r] = a;
+      }
+      continue;
     }
-    return;
+    memcpy(x, xn, (size_t)nx * sizeof(double)); /* the same sums, stage by stage over the vector */
+    for (int j = 0; j < s; j++) {
+      const double hw = h * w[j], *v = ve + j * sb;
+      for (int r = 0; r < nx; r++) x[r] += hw * v[r];
+    }
   }
-  memcpy(x, xn, (size_t)nx * sizeof(double)); /* the same sums, stage by stage over the vector */
-  for (int j = 0; j < s; j++) {
-    const double hw = h * w[j], *v = ve + j * sb;
-    for (int r = 0; r < nx; r++) x[r] += hw * v[r];
-  }
+}
+
+void fesd__poly_state(const fesd_integrator *it, const double *z, int n, const double *w, double *x) {
+  poly_states(it, z, n, w, 1, x);
 }
 
 void fesd__state_at(fesd_integrator *it, const double *z, int N, double t, double *x) {
@@ -355,7 +363,7 @@ static int scan_interior(fesd_integrator *it, const double *z, const unsigned ch
   fesd__system *S = &it->sys;
   fesd__model *m = &it->model;
   const int s = S->s, nth = S->nth;
-  double *x = it->gbuf + nth;
+  double *xm = it->gbuf + nth; /* the midpoint states of an element */
   fesd__point_eval pe = fesd__scratch_eval(it);
   double tn = 0;
   for (int n = 0; n < S->N; n++) {
@@ -366,8 +374,9 @@ static int scan_interior(fesd_integrator *it, const double *z, const unsigned ch
       int j;
       sliding = fesd__two_modes(&it->model, a, k, &j) >= 0;
     }
+    poly_states(it, z, n, it->mid_w, it->n_mid, xm);
     for (int p = 0; p < it->n_mid; p++) {
-      fesd__poly_state(it, z, n, it->mid_w + p * FESD_RK_MAX_STAGES, x);
+      const double *x = xm + (size_t)p * S->nx;
       fesd__point_eval q = pe;
       if (!sliding) q.F = q.dgdx = NULL;
       const double t = tn + it->mid_tau[p] * h;
@@ -387,8 +396,9 @@ static int scan_interior(fesd_integrator *it, const double *z, const unsigned ch
           note(&ps[k], &v);
           continue;
         }
+        if (!sliding) continue;
         int j, i = fesd__two_modes(&it->model, a, k, &j);
-        if (i < 0 || !sliding) continue;
+        if (i < 0) continue;
         int c = filippov(it, &q, th, it->ftot, i, j, FIL_MID_TOL);
         if (c == -2 || !alternative_exists(it, &q, a, k, i, j)) continue;
         fesd__violation v = {1, t, c < 0 ? i : c, k, 0, n, n * s + s, 0, c < 0 ? -1 : 1, 0, 0};
