@@ -59,7 +59,7 @@ int main(int argc, char **argv) {
   pwa_rng pick = {90210}; /* run settings, the same in every shard */
   int index = 0;
   for (int c = 0; c < N_KINDS; c++) {
-    pwa_rng rng = {424242 + 100 * (uint64_t)c};
+    pwa_rng rng = {424242 + pr_seed_off() + 100 * (uint64_t)c};
     tally tk = {0};
     for (int i = 0; i < N_PER_KIND; i++, index++) {
       /* every shard draws every system (the generator's sequence), runs its own */
