@@ -93,15 +93,17 @@ int fesd__stage_newton(fesd_integrator *it, double *z, int n, const double *xn, 
   fesd__point_eval pj = {0};
   pj.dFdx = it->pscr.dFdx;
   const int predict = !it->gn_warm;
-  if (predict) {
+  int from_warm = 1; /* set to 0 when the start from V = 0 is taken */
+  if (predict) pj.F = it->pscr.F;
+  if (predict && !stage_key(it, z, n, xn, h, tn, &pj) && !stage_factor(it)) {
     /* Unless the warm start solved the last element as it was: start with the Newton step
      * from V = 0, where every stage point is x_n, so its residual is -F(x_n) theta_j and its
      * Jacobian the key's (one evaluation at x_n instead of s at the warm start's stage points;
      * exact for a field linear in x, and O(h^2) off for a smooth one where the warm start,
-     * the last stage's v, is O(h) off). */
-    pj.F = it->pscr.F;
-    if (stage_key(it, z, n, xn, h, tn, &pj) || stage_factor(it)) return 1;
+     * the last stage's v, is O(h) off). A failed key or factorization leaves the warm start,
+     * which may hold without one. */
     factored = 1;
+    from_warm = 0;
     for (int j = 0; j < s; j++) {
       const double *th = z + fesd__th(S, n, j), *tp = j > 0 ? z + fesd__th(S, n, j - 1) : NULL;
       double *g = G + j * nx;
@@ -121,7 +123,6 @@ int fesd__stage_newton(fesd_integrator *it, double *z, int n, const double *xn, 
       for (int r = 0; r < nx; r++) v[r] = -G[j * nx + r];
     }
   }
-  int from_warm = !predict;
 again:
   for (int iter = 0; iter < 6; iter++) {
     double gmax = 0, vmax = 0;
