@@ -69,6 +69,14 @@ int fesd__model_g(fesd__model *m, double t, const double *x, const double *u, do
  * writes the second to *j when exactly two are active (a 2-mode sliding mode), else -1. */
 int fesd__two_modes(const fesd__model *m, const unsigned char *a, int k, int *j);
 void fesd__F_axpy(const fesd__model *m, const fesd__point_eval *pe, int i, double a, double *y);
+/* g = v - sum_i theta_i F_i at the evaluated point: the residual of a stage equation (the step
+ * system's V rows, the guess's stage Newton, the certified start solve). */
+static inline void fesd__stage_residual(const fesd__model *m, const fesd__point_eval *pe, const double *v,
+                                        const double *th, double *g) {
+  for (int r = 0; r < m->nx; r++) g[r] = v[r];
+  for (int i = 0; i < m->nth; i++)
+    if (th[i] != 0.0) fesd__F_axpy(m, pe, i, -th[i], g);
+}
 /* grad g_i . v (v dense, nx) */
 double fesd__dg_dot(const fesd__model *m, const fesd__point_eval *pe, int i, const double *v);
 /* y += a grad g_i (y dense, nx) */

@@ -10,6 +10,16 @@
 #include "common/dense_lu.h"
 #include "fesd/step.h"
 
+/* Stage j > 0 of element n has the theta of the stage before (its key block and residual
+ * are then the same). */
+static int same_theta(const fesd__system *S, const double *z, int n, int j) {
+  if (j == 0) return 0;
+  const double *th = z + fesd__th(S, n, j), *tp = th - S->sb;
+  for (int i = 0; i < S->nth; i++)
+    if (th[i] != tp[i]) return 0;
+  return 1;
+}
+
 /* Key of the stage matrix of element n (h, then J_j = sum_i theta_j,i df_i/dx at x_n for each
  * stage j on the union pattern) into it->gn_key; its LU is in it->gn when it equals the key
  * of the factorization kept (it->gn_memo). Returns 1 on a failed evaluation. */
@@ -29,14 +39,11 @@ static int stage_key(fesd_integrator *it, const double *z, int n, const double *
   }
   it->gn_key[0] = h;
   for (int j = 0; j < S->s; j++) {
-    const double *th = z + fesd__th(S, n, j), *tp = j > 0 ? z + fesd__th(S, n, j - 1) : NULL;
     double *J = it->gn_key + 1 + (size_t)j * nnz;
-    int same = tp != NULL; /* the stage before has the same theta (no switch): its J */
-    for (int i = 0; i < S->nth && same; i++) same = th[i] == tp[i];
-    if (same)
+    if (same_theta(S, z, n, j)) /* no switch between the stages: the J before */
       for (int e = 0; e < nnz; e++) J[e] = J[e - nnz];
     else
-      fesd__Jth(m, pj, th, J);
+      fesd__Jth(m, pj, z + fesd__th(S, n, j), J);
   }
   return 0;
 }
@@ -84,7 +91,7 @@ static int stage_factor(fesd_integrator *it) {
 int fesd__stage_newton(fesd_integrator *it, double *z, int n, const double *xn, double h, double tn) {
   fesd__system *S = &it->sys;
   fesd__model *m = &it->model;
-  const int nx = S->nx, s = S->s, q = s * nx, nth = S->nth;
+  const int nx = S->nx, s = S->s, q = s * nx;
   if (!it->gn || q > FESD__GN_MAX || S->tab.is_explicit) return 1;
   double *G = it->gn + (size_t)q * q, *V0 = G + q;
   for (int j = 0; j < s; j++) memcpy(V0 + j * nx, z + fesd__v(S, n, j), (size_t)nx * sizeof(double));
@@ -104,17 +111,15 @@ int fesd__stage_newton(fesd_integrator *it, double *z, int n, const double *xn, 
      * which may hold without one. */
     factored = 1;
     from_warm = 0;
-    for (int j = 0; j < s; j++) {
-      const double *th = z + fesd__th(S, n, j), *tp = j > 0 ? z + fesd__th(S, n, j - 1) : NULL;
+    for (int j = 0; j < s; j++) { /* the residual at V = 0: -F(x_n) theta_j (the stage before's if the same) */
       double *g = G + j * nx;
-      int same = tp != NULL; /* the stage before has the same theta: its residual */
-      for (int i = 0; i < nth && same; i++) same = th[i] == tp[i];
-      if (same) {
+      if (same_theta(S, z, n, j)) {
         memcpy(g, g - nx, (size_t)nx * sizeof(double));
         continue;
       }
+      const double *th = z + fesd__th(S, n, j);
       memset(g, 0, (size_t)nx * sizeof(double));
-      for (int i = 0; i < nth; i++)
+      for (int i = 0; i < S->nth; i++)
         if (th[i] != 0.0) fesd__F_axpy(m, &pj, i, -th[i], g);
     }
     fesd__dense_lu_solve(q, it->gn, it->gn_piv, G);
@@ -143,13 +148,14 @@ again:
       fesd__point_eval pe = {0};
       if (!pf) { /* the fields alone (also when a Jacobian or switch callback failed there) */
         pe.F = it->pscr.F;
-        if (fesd__model_fields_active(m, tj, X, S->u, pe.F, th)) goto restore; /* the sweeps report it */
+        if (fesd__model_fields_active(m, tj, X, S->u, pe.F, th)) { /* the sweeps report it */
+          from_warm = 1;
+          goto restore;
+        }
         pf = &pe;
       }
       double *g = G + j * nx;
-      memcpy(g, v, (size_t)nx * sizeof(double));
-      for (int i = 0; i < nth; i++)
-        if (th[i] != 0.0) fesd__F_axpy(m, pf, i, -th[i], g);
+      fesd__stage_residual(m, pf, v, th, g);
       for (int r = 0; r < nx; r++) {
         gmax = fesd__fmax(gmax, fabs(g[r]));
         vmax = fesd__fmax(vmax, fabs(v[r]));
@@ -159,9 +165,10 @@ again:
     if (gmax <= 1e-14 * vmax || gmax == 0.0) {
       it->gn_full_at = iter;
       /* a prediction that reproduced the warm start (a constant field): check it first next */
-      it->gn_warm = iter == 0 && (!predict || !memcmp(V0, z + fesd__v(S, n, 0), (size_t)nx * sizeof(double)));
-      for (int j = 1; j < s && it->gn_warm; j++)
-        it->gn_warm = !memcmp(V0 + j * nx, z + fesd__v(S, n, j), (size_t)nx * sizeof(double));
+      int warm = iter == 0;
+      for (int j = 0; j < s && warm && predict; j++)
+        warm = !memcmp(V0 + j * nx, z + fesd__v(S, n, j), (size_t)nx * sizeof(double));
+      it->gn_warm = warm;
       return 0;
     }
     if (gmax > 0.5 * gprev) break; /* not converging like Newton */
@@ -174,14 +181,12 @@ again:
       for (int r = 0; r < nx; r++) v[r] -= G[j * nx + r];
     }
   }
+restore:
   for (int j = 0; j < s; j++) memcpy(z + fesd__v(S, n, j), V0 + j * nx, (size_t)nx * sizeof(double));
   if (!from_warm) { /* the start from V = 0 did not converge: Newton from the warm start */
     from_warm = 1;
     gprev = INFINITY;
     goto again;
   }
-  return 1;
-restore:
-  for (int j = 0; j < s; j++) memcpy(z + fesd__v(S, n, j), V0 + j * nx, (size_t)nx * sizeof(double));
   return 1;
 }

@@ -242,9 +242,7 @@ static int certified(fesd_integrator *it, fesd_step_info *info) {
       const double *v = z + fesd__v(S, n, j), *th = z + fesd__th(S, n, j);
       const fesd__point_eval *pe = &S->pe[n * S->s + j];
       const double *wv = w + S->rel[n] + j * S->rs;
-      for (int r = 0; r < S->nx; r++) g[r] = v[r];
-      for (int i = 0; i < S->nth; i++)
-        if (th[i] != 0.0) fesd__F_axpy(m, pe, i, -th[i], g);
+      fesd__stage_residual(m, pe, v, th, g);
       for (int r = 0; r < S->nx; r++) res = fesd__fmax(res, fabs(g[r] * wv[r]));
     }
   if (!(res <= it->set.newton_tol)) return 0;

@@ -397,9 +397,7 @@ int fesd__system_eval(const double *z, double *raw, double *jac, void *ctx) {
       const int rV = S->rel[n] + j * S->rs, rG = rV + nx, rS = rG + nth;
       const double *v = z + fesd__v(S, n, j), *th = z + fesd__th(S, n, j);
       const double *la = z + fesd__la(S, n, j), *mu = z + fesd__mu(S, n, j);
-      for (int r = 0; r < nx; r++) raw[rV + r] = v[r];
-      for (int i = 0; i < nth; i++)
-        if (th[i] != 0.0) fesd__F_axpy(m, pe, i, -th[i], raw + rV);
+      fesd__stage_residual(m, pe, v, th, raw + rV);
       for (int i = 0; i < nth; i++) raw[rG + i] = pe->g[i] - la[i] - mu[m->sys_of[i]];
       if (S->look && j == 0)
         for (int i = 0; i < nth; i++) raw[rG + i] += S->LK[(size_t)n * nth + i];
