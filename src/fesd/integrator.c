@@ -1,3 +1,4 @@
+#include "common/block.h"
 #include "fesd/integrator.h"
 
 #include <math.h>
@@ -69,21 +70,11 @@ void fesd_free(fesd_integrator **itp) {
   fesd__wrap_free(&it->wrap);
   free(it->log);
   free(it->log_pool);
-  double *bufs[] = {it->x,  it->lam00, it->theta_prev, it->u_cur, it->ws_blk, it->z,     it->z0,
-                    it->zpred, it->zp, it->raw,       it->Sx,    it->Su,
-                    it->Dtmp, it->Stmp, it->gbuf,     it->blk,   it->vtmp,   it->pt_t,  it->pt_q,
-                    it->pt_l, it->rec_h, it->rec_t,   it->rec_x, it->rec_th, it->rec_la, it->rec_mu,
-                    it->rec_v, it->zfast, it->bt, it->ftot, it->gdense, it->bseg_lo, it->bseg_hi, it->hlo, it->hhi, it->err_atol, it->tol_atol, it->slide_tmp};
-  for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); i++) free(bufs[i]);
-  for (fesd__saved *b = &it->bk; b <= &it->bk_sub; b++) {
-    double *saved[] = {b->x, b->lam, b->th, b->blk, b->Sx, b->Su, b->ldp};
-    for (size_t i = 0; i < sizeof(saved) / sizeof(saved[0]); i++) free(saved[i]);
-  }
-  void *other[] = {it->eq_active, it->pair_mode, it->pt_src, it->kb,   it->sw_at,    it->act,
-                   it->act0,      it->cand,      it->swap_set, it->bmode, it->exit_mode, it->jump_in,
-                   it->jump_out,  it->scan_buf,  it->plan,   it->plan_after, it->bseg, it->events, it->ev_pool, it->raw_border, it->col_border,
-                   it->gn, it->gn_key, it->gn_piv, it->fil_th, it->fil_a, it->rk_act, it->rk_bmode};
-  for (size_t i = 0; i < sizeof(other) / sizeof(other[0]); i++) free(other[i]);
+  double *recs[] = {it->rec_h, it->rec_t, it->rec_x, it->rec_th, it->rec_la, it->rec_mu, it->rec_v};
+  for (size_t i = 0; i < sizeof(recs) / sizeof(recs[0]); i++) free(recs[i]);
+  free(it->events);
+  free(it->ev_pool);
+  fesd__block_free(it->mem);
   free(it);
   *itp = NULL;
 }
@@ -140,10 +131,88 @@ int fesd__use_level(fesd_integrator *it, int N) {
   return FESD_OK;
 }
 
-static double *dalloc(size_t n, int *fail) {
-  double *p = calloc(n > 0 ? n : 1, sizeof(double));
-  if (!p) *fail = 1;
-  return p;
+/* The arrays of the integrator, in one block (common/block.h): sizes from the layout at
+ * creation (N_cap elements, the largest system); the event lists and the step records grow,
+ * and stay separate allocations. */
+static void lay_out(fesd_integrator *it, const fesd_settings *settings, fesd__block *B) {
+  const fesd__system *S = &it->sys;
+  const size_t n = (size_t)S->n, nx = (size_t)it->nx, nu = (size_t)it->nu, nth = (size_t)it->nth;
+  const size_t np = (size_t)it->np, N = (size_t)it->N_cap, s = (size_t)S->s, nsys = (size_t)it->nsys;
+  const size_t cp = (size_t)it->cap_plan;
+  it->x = fesd__block_doubles(B, nx);
+  it->lam00 = fesd__block_doubles(B, nth);
+  it->theta_prev = fesd__block_doubles(B, nth);
+  it->u_cur = fesd__block_doubles(B, nu);
+  it->ws_blk = fesd__block_doubles(B, (size_t)S->sb);
+  it->z = fesd__block_doubles(B, n);
+  it->z0 = fesd__block_doubles(B, n);
+  it->zpred = fesd__block_doubles(B, n);
+  it->zp = fesd__block_doubles(B, n);
+  it->raw = fesd__block_doubles(B, (size_t)S->n_raw);
+  /* sensitivity storage is O(n_x^2): only when asked for */
+  const size_t sx = settings->sensitivities ? nx : 1;
+  for (fesd__saved *b = &it->bk; b <= &it->bk_sub; b++) {
+    b->x = fesd__block_doubles(B, nx);
+    b->lam = fesd__block_doubles(B, nth);
+    b->th = fesd__block_doubles(B, nth);
+    b->blk = fesd__block_doubles(B, (size_t)S->sb);
+    b->Sx = fesd__block_doubles(B, sx * sx);
+    b->Su = fesd__block_doubles(B, sx * nu);
+    b->ldp = fesd__block_doubles(B, settings->sensitivities ? nth * np : 1);
+  }
+  it->Sx = fesd__block_doubles(B, sx * sx);
+  it->Su = fesd__block_doubles(B, sx * nu);
+  it->Dtmp = fesd__block_doubles(B, settings->sensitivities ? (nx > nth ? nx : nth) * np : 1);
+  it->Stmp = fesd__block_doubles(B, settings->sensitivities ? nx * (nx > nu ? nx : nu) : 1);
+  it->gbuf = fesd__block_doubles(B, nth + (size_t)(FESD_RK_MAX_STAGES + 1) * nx); /* + the midpoint states */
+  it->blk = fesd__block_doubles(B, (size_t)S->sb);
+  it->vtmp = fesd__block_doubles(B, 2 * nx);
+  it->ftot = fesd__block_doubles(B, 4 * nx); /* total field; first_step: two more states, weights */
+  it->err_atol = fesd__block_doubles(B, nx);
+  it->tol_atol = fesd__block_doubles(B, nx);
+  it->gdense = fesd__block_doubles(B, nx); /* calloc: zero */
+  it->pt_t = fesd__block_doubles(B, N * (s + 1) + 1);
+  it->pt_q = fesd__block_doubles(B, (N * (s + 1) + 1) * nth);
+  it->pt_l = fesd__block_doubles(B, (N * (s + 1) + 1) * nth);
+  it->zfast = fesd__block_doubles(B, n);
+  it->bt = fesd__block_doubles(B, cp + 2);
+  it->bseg_lo = fesd__block_doubles(B, cp + 2);
+  it->bseg_hi = fesd__block_doubles(B, cp + 2);
+  it->hlo = fesd__block_doubles(B, N);
+  it->hhi = fesd__block_doubles(B, N);
+  it->eq_active = fesd__block_take(B, (size_t)S->n_eq, 0);
+  it->pair_mode = fesd__block_take(B, (size_t)(S->n_pair > 0 ? S->n_pair : 1), 0);
+  it->raw_border = fesd__block_take(B, (size_t)S->n_raw, 0);
+  it->col_border = fesd__block_take(B, n, 0);
+  it->pt_src = fesd__block_take(B, (N * (s + 1) + 1) * sizeof(int), 0);
+  it->kb = fesd__block_take(B, (cp + N + 2) * sizeof(int), 0);
+  it->sw_at = fesd__block_take(B, (N + 1) * sizeof(int), 0);
+  it->act = fesd__block_take(B, N * s * nth, 0); /* per stage */
+  it->act0 = fesd__block_take(B, nth, 0);
+  it->cand = fesd__block_take(B, nth, 0);
+  it->swap_set = fesd__block_take(B, nth, 0);
+  it->bmode = fesd__block_take(B, (N + 1) * sizeof(int), 1);
+  it->exit_mode = fesd__block_take(B, (N + 1) * sizeof(int), 1);
+  it->rk_act = fesd__block_take(B, N * s * nth, 0);
+  it->rk_bmode = fesd__block_take(B, (2 * (N + 1)) * sizeof(int), 1); /* bmode, then exit_mode */
+  it->jump_in = fesd__block_take(B, nsys * sizeof(int), 0);
+  it->jump_out = fesd__block_take(B, nsys * sizeof(int), 0);
+  it->scan_buf = fesd__block_take(B, nsys * sizeof(*it->scan_buf), 0);
+  it->plan = fesd__block_take(B, cp * sizeof(*it->plan), 0);
+  it->plan_after = fesd__block_take(B, cp * nth, 0);
+  it->bseg = fesd__block_take(B, (cp + 2) * sizeof(int), 0);
+  it->fil_th = fesd__block_doubles(B, nth);
+  it->slide_tmp = fesd__block_doubles(B, 2 * nx);
+  it->fil_a = fesd__block_take(B, nth, 0);
+  const int gq = s * nx; /* the guess's stage Newton: small systems only */
+  if (gq <= FESD__GN_MAX && !it->tab.is_explicit) {
+    it->gn = fesd__block_doubles(B, (size_t)gq * gq + 2 * (size_t)gq + (size_t)nx * nx);
+    const size_t nk = 1 + (size_t)s * (size_t)it->model.pf_nnz;
+    it->gn_key = fesd__block_doubles(B, 2 * nk);
+    it->gn_memo = it->gn_key ? it->gn_key + nk : NULL;
+    it->gn_piv = fesd__block_take(B, (size_t)gq * sizeof(int), 0);
+    it->gn_full_at = 1;
+  }
 }
 
 int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_settings *settings) {
@@ -189,6 +258,12 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   }
   fesd__system *S = &it->sys;
   it->tab = tab;
+  for (int j = 0; j < tab.s; j++) {
+    double d = 1;
+    for (int m = 0; m < tab.s; m++)
+      if (m != j) d *= tab.c[j] - tab.c[m];
+    it->lag_inv[j] = d != 0 ? 1 / d : 0; /* 0: repeated nodes (explicit RK), no polynomial */
+  }
   fesd_tableau_get(FESD_RK_GAUSS_LEGENDRE, tab.s, &it->quad);
   fesd__interior_setup(it);
   fesd__error_setup(it);
@@ -199,99 +274,19 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   it->nsys = internal.nsys;
   it->s = S->s;
   it->np = it->nx + it->nu;
-  const size_t n = (size_t)S->n, nx = (size_t)it->nx, nu = (size_t)it->nu, nth = (size_t)it->nth;
-  const size_t np = (size_t)it->np, N = (size_t)it->N_cap, s = (size_t)S->s, nsys = (size_t)it->nsys;
   it->cap_plan = 2 * it->N_cap;
-  const size_t cp = (size_t)it->cap_plan;
-  int fail = 0;
-  it->x = dalloc(nx, &fail);
-  it->lam00 = dalloc(nth, &fail);
-  it->theta_prev = dalloc(nth, &fail);
-  it->u_cur = dalloc(nu, &fail);
-  it->ws_blk = dalloc((size_t)S->sb, &fail);
-  it->z = dalloc(n, &fail);
-  it->z0 = dalloc(n, &fail);
-  it->zpred = dalloc(n, &fail);
-  it->zp = dalloc(n, &fail);
-  it->raw = dalloc((size_t)S->n_raw, &fail);
-  /* sensitivity storage is O(n_x^2): only when asked for */
-  const size_t sx = settings->sensitivities ? nx : 1;
-  for (fesd__saved *b = &it->bk; b <= &it->bk_sub; b++) {
-    b->x = dalloc(nx, &fail);
-    b->lam = dalloc(nth, &fail);
-    b->th = dalloc(nth, &fail);
-    b->blk = dalloc((size_t)S->sb, &fail);
-    b->Sx = dalloc(sx * sx, &fail);
-    b->Su = dalloc(sx * nu, &fail);
-    b->ldp = dalloc(settings->sensitivities ? nth * np : 1, &fail);
-  }
-  it->Sx = dalloc(sx * sx, &fail);
-  it->Su = dalloc(sx * nu, &fail);
-  it->Dtmp = dalloc(settings->sensitivities ? (nx > nth ? nx : nth) * np : 1, &fail);
-  it->Stmp = dalloc(settings->sensitivities ? nx * (nx > nu ? nx : nu) : 1, &fail);
-  it->gbuf = dalloc(nth + (size_t)(FESD_RK_MAX_STAGES + 1) * nx, &fail); /* + the midpoint states */
-  it->blk = dalloc((size_t)S->sb, &fail);
-  it->vtmp = dalloc(2 * nx, &fail);
-  it->ftot = dalloc(4 * nx, &fail); /* total field; first_step: two more states, weights */
-  it->err_atol = dalloc(nx, &fail);
-  it->tol_atol = dalloc(nx, &fail);
-  it->gdense = dalloc(nx, &fail); /* calloc: zero */
-  if (fesd__point_alloc(&it->model, &it->pscr, 1)) fail = 1;
-  it->pt_t = dalloc(N * (s + 1) + 1, &fail);
-  it->pt_q = dalloc((N * (s + 1) + 1) * nth, &fail);
-  it->pt_l = dalloc((N * (s + 1) + 1) * nth, &fail);
-  it->zfast = dalloc(n, &fail);
-  it->bt = dalloc(cp + 2, &fail);
-  it->bseg_lo = dalloc(cp + 2, &fail);
-  it->bseg_hi = dalloc(cp + 2, &fail);
-  it->hlo = dalloc(N, &fail);
-  it->hhi = dalloc(N, &fail);
-  it->eq_active = malloc((size_t)S->n_eq);
-  it->pair_mode = malloc((size_t)(S->n_pair > 0 ? S->n_pair : 1));
-  it->raw_border = malloc((size_t)S->n_raw);
-  it->col_border = malloc(n);
-  it->pt_src = malloc((N * (s + 1) + 1) * sizeof(int));
-  it->kb = malloc((cp + N + 2) * sizeof(int));
-  it->sw_at = malloc((N + 1) * sizeof(int));
-  it->act = malloc(N * s * nth); /* per stage */
-  it->act0 = malloc(nth);
-  it->cand = malloc(nth);
-  it->swap_set = malloc(nth);
-  it->bmode = calloc(N + 1, sizeof(int));
-  it->exit_mode = calloc(N + 1, sizeof(int));
-  it->rk_act = malloc(N * s * nth);
-  it->rk_bmode = calloc(2 * (N + 1), sizeof(int)); /* bmode, then exit_mode */
-  if (!it->rk_act || !it->rk_bmode) fail = 1;
-  it->jump_in = malloc(nsys * sizeof(int));
-  it->jump_out = malloc(nsys * sizeof(int));
-  it->scan_buf = malloc(nsys * sizeof(*it->scan_buf));
-  it->plan = malloc(cp * sizeof(*it->plan));
-  it->plan_after = malloc(cp * nth);
-  it->bseg = malloc((cp + 2) * sizeof(int));
-  it->fil_th = dalloc(nth, &fail);
-  it->slide_tmp = dalloc(2 * nx, &fail);
-  it->fil_a = malloc(nth);
-  if (!it->fil_a) fail = 1;
-  const int gq = s * nx; /* the guess's stage Newton: small systems only */
-  if (gq <= FESD__GN_MAX && !it->tab.is_explicit) {
-    it->gn = dalloc((size_t)gq * gq + 2 * (size_t)gq + (size_t)nx * nx, &fail);
-    const size_t nk = 1 + (size_t)s * (size_t)it->model.pf_nnz;
-    it->gn_key = dalloc(2 * nk, &fail);
-    it->gn_memo = it->gn_key ? it->gn_key + nk : NULL;
-    it->gn_piv = malloc((size_t)gq * sizeof(int));
-    it->gn_full_at = 1;
-    if (!it->gn_piv) fail = 1;
-  }
+  fesd__block B = {0};
+  lay_out(it, settings, &B); /* sizing pass */
+  it->mem = fesd__block_open(&B);
+  if (it->mem) lay_out(it, settings, &B);
+  int fail = !it->mem || fesd__point_alloc(&it->model, &it->pscr, 1) != FESD_OK;
   int max_nf = 0;
   for (int k = 0; k < it->nsys; k++) max_nf = it->model.nf[k] > max_nf ? it->model.nf[k] : max_nf;
   it->ev_span = 2 * max_nf;
   it->ev_max = FESD_EVENTS_INIT;
   it->events = malloc((size_t)it->ev_max * sizeof(fesd_event));
   it->ev_pool = malloc((size_t)it->ev_max * (size_t)it->ev_span * sizeof(int));
-  if (fail || !it->eq_active || !it->pair_mode || !it->pt_src || !it->kb || !it->sw_at || !it->act ||
-      !it->act0 || !it->cand || !it->swap_set || !it->bmode || !it->exit_mode || !it->jump_in ||
-      !it->jump_out || !it->scan_buf || !it->plan || !it->plan_after || !it->bseg || !it->events || !it->ev_pool ||
-      !it->raw_border || !it->col_border) {
+  if (fail || !it->events || !it->ev_pool) {
     fesd_free(&it);
     return FESD_ERR_NOMEM;
   }

@@ -79,6 +79,7 @@ struct fesd_integrator {
   /* current state */
   double t;
   double t_c; /* compensation of the sum of the step lengths (t is their Kahan sum) */
+  void *mem; /* the block of the arrays below that do not grow (lay_out, integrator.c) */
   double *x, *lam00, *theta_prev, *u_cur, *ws_blk; /* ws_blk: last stage block of the last step */
   int have_state, have_ws, have_prev_theta;
   /* step data (sized for N_cap elements) */
@@ -144,6 +145,7 @@ struct fesd_integrator {
   int cap_el, n_el;
   double *rec_h, *rec_t, *rec_x, *rec_th, *rec_la, *rec_mu, *rec_v;
   fesd_tableau tab, quad; /* the method, and a Gauss rule for dense output */
+  double lag_inv[FESD_RK_MAX_STAGES]; /* 1 / prod_{m != j} (c_j - c_m): Lagrange basis of tab */
   /* interior checks: collocation weights at the midpoints between consecutive nodes
    * {0, c_j, 1} (fixed by the tableau, so computed once at create) */
   int n_mid;
