@@ -90,17 +90,19 @@ int fesd_dense_output(const fesd_integrator *it, double t, double *x) {
 void fesd__colloc_weights(const fesd_integrator *it, double tau, double *w) {
   const fesd_tableau *T = &it->tab;
   const int s = T->s, nq = it->quad.s;
-  double num[FESD_RK_MAX_STAGES][FESD_RK_MAX_STAGES], den[FESD_RK_MAX_STAGES]; /* (the same */
-  for (int q = 0; q < nq; q++) /* differences as inside the product, formed once) */
-    for (int m = 0; m < s; m++) num[q][m] = tau * it->quad.c[q] - T->c[m];
-  for (int j = 0; j < s; j++) {
-    for (int m = 0; m < s; m++) den[m] = T->c[j] - T->c[m];
-    w[j] = 0; /* int_0^tau l_j by the Gauss rule (exact: degree s - 1) */
-    for (int q = 0; q < nq; q++) {
-      double l = 1;
-      for (int m = 0; m < s; m++)
-        if (m != j) l *= num[q][m] / den[m];
-      w[j] += tau * it->quad.b[q] * l;
+  for (int j = 0; j < s; j++) w[j] = 0;
+  /* int_0^tau l_j by the Gauss rule (exact: degree s - 1); at each point the products of all
+   * factors but one from prefix and suffix products (no divisions: a zero factor is fine) */
+  for (int q = 0; q < nq; q++) {
+    const double t = tau * it->quad.c[q], bq = tau * it->quad.b[q];
+    double suf[FESD_RK_MAX_STAGES + 1];
+    suf[s] = 1;
+    for (int m = s - 1; m > 0; m--) suf[m] = suf[m + 1] * (t - T->c[m]);
+    double pre = 1;
+    for (int j = 0; j < s; j++) {
+      w[j] += bq * pre * suf[j + 1];
+      pre *= t - T->c[j];
     }
   }
+  for (int j = 0; j < s; j++) w[j] *= it->lag_inv[j];
 }
