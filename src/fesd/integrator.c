@@ -64,7 +64,6 @@ void fesd_free(fesd_integrator **itp) {
   if (!itp || !*itp) return;
   fesd_integrator *it = *itp;
   for (int l = 0; l < it->n_lv; l++) level_free(&it->lv[l]);
-  fesd__point_free(&it->pscr);
   fesd__system_free(&it->sys);
   fesd__model_free(&it->model);
   fesd__wrap_free(&it->wrap);
@@ -204,6 +203,7 @@ static void lay_out(fesd_integrator *it, const fesd_settings *settings, fesd__bl
   it->fil_th = fesd__block_doubles(B, nth);
   it->slide_tmp = fesd__block_doubles(B, 2 * nx);
   it->fil_a = fesd__block_take(B, nth, 0);
+  fesd__point_take(&it->model, &it->pscr, 1, B);
   const int gq = s * nx; /* the guess's stage Newton: small systems only */
   if (gq <= FESD__GN_MAX && !it->tab.is_explicit) {
     it->gn = fesd__block_doubles(B, (size_t)gq * gq + 2 * (size_t)gq + (size_t)nx * nx);
@@ -279,7 +279,7 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   lay_out(it, settings, &B); /* sizing pass */
   it->mem = fesd__block_open(&B);
   if (it->mem) lay_out(it, settings, &B);
-  int fail = !it->mem || fesd__point_alloc(&it->model, &it->pscr, 1) != FESD_OK;
+  int fail = !it->mem;
   int max_nf = 0;
   for (int k = 0; k < it->nsys; k++) max_nf = it->model.nf[k] > max_nf ? it->model.nf[k] : max_nf;
   it->ev_span = 2 * max_nf;

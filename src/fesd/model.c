@@ -276,15 +276,15 @@ fail:
   return st;
 }
 
-/* One block per point (g first: it owns the block), the fields' arrays only when asked for:
- * the system keeps a few records per stage of its largest layout. */
-int fesd__point_alloc(const fesd__model *m, fesd__point_eval *pe, int fields) {
+/* A point's arrays from the block B (one piece per point), the fields' arrays only when asked
+ * for: the system keeps a few records per stage of its largest layout. */
+void fesd__point_take(const fesd__model *m, fesd__point_eval *pe, int fields, fesd__block *B) {
   const size_t nu = (size_t)(m->nu > 0 ? m->nu : 1), nth = (size_t)m->nth;
   const size_t ndg = (size_t)(m->ndg > 0 ? m->ndg : 1), nF = (size_t)(m->nF > 0 ? m->nF : 1);
   const size_t ndF = (size_t)(m->ndF > 0 ? m->ndF : 1), nFu = (size_t)(m->nFu > 0 ? m->nFu : 1);
   memset(pe, 0, sizeof(*pe));
-  double *b = malloc((nth + ndg + nth * nu + (fields ? nF + ndF + nFu : 0)) * sizeof(double));
-  if (!b) return FESD_ERR_NOMEM;
+  double *b = fesd__block_take(B, (nth + ndg + nth * nu + (fields ? nF + ndF + nFu : 0)) * sizeof(double), 0);
+  if (!b) return; /* the sizing pass */
   pe->g = b;
   pe->dgdx = pe->g + nth;
   pe->dgdu = pe->dgdx + ndg;
@@ -293,12 +293,6 @@ int fesd__point_alloc(const fesd__model *m, fesd__point_eval *pe, int fields) {
     pe->dFdx = pe->F + nF;
     pe->dFdu = pe->dFdx + ndF;
   }
-  return FESD_OK;
-}
-
-void fesd__point_free(fesd__point_eval *pe) {
-  free(pe->g);
-  memset(pe, 0, sizeof(*pe));
 }
 
 int fesd__two_modes(const fesd__model *m, const unsigned char *a, int k, int *j) {

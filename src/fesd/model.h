@@ -6,6 +6,7 @@
 #ifndef FESD_MODEL_H
 #define FESD_MODEL_H
 
+#include "common/block.h"
 #include "fesd_integrator.h"
 
 typedef struct {
@@ -51,9 +52,9 @@ static inline double fesd__fmin(double a, double b) { return a < b || b != b ? a
 
 int fesd__model_init(fesd__model *m, const fesd_model *user);
 void fesd__model_free(fesd__model *m);
-/* Allocate / free the arrays of a point evaluation for this model. */
-int fesd__point_alloc(const fesd__model *m, fesd__point_eval *pe, int fields);
-void fesd__point_free(fesd__point_eval *pe);
+/* The arrays of a point evaluation for this model, from a workspace's block (common/block.h;
+ * all NULL in its sizing pass). */
+void fesd__point_take(const fesd__model *m, fesd__point_eval *pe, int fields, fesd__block *B);
 /* Evaluate at (t, x) (u may be NULL when nu == 0). Returns FESD_OK, FESD_ERR_CALLBACK or
  * FESD_ERR_NONFINITE (m->failed names the callback). */
 int fesd__model_eval(fesd__model *m, double t, const double *x, const double *u, fesd__point_eval *out);

@@ -6,43 +6,8 @@
 
 void fesd__system_free(fesd__system *S) {
   if (!S) return;
-  if (S->pe) {
-    int np = S->N_cap * S->s + S->N_cap;
-    for (int p = 0; p < np; p++) fesd__point_free(&S->pe[p]);
-  }
-  free(S->pe);
-  free(S->el);
-  free(S->xo);
-  free(S->ho);
-  free(S->lbo);
-  free(S->rel);
-  free(S->rlb);
-  free(S->rx);
-  free(S->X);
-  free(S->pc_z);
-  free(S->pc_xu);
-  free(S->pt_X);
-  free(S->pt_t);
-  free(S->pt_lvl);
-  free(S->pt_u);
-  free(S->Jth);
-  free(S->JK);
-  free(S->KG);
-  free(S->Juth);
-  free(S->lam00_dp);
-  free(S->tmp);
-  free(S->exit_ext);
-  free(S->lbm);
-  free(S->LK);
-  free(S->dgl);
-  free(S->dgul);
-  free(S->xs);
-  fesd__point_free(&S->pl);
+  fesd__block_free(S->mem);
   free(S->wraw);
-  free(S->wG);
-  double *mags[] = {S->magX, S->magV, S->magG, S->refX, S->refV, S->refG};
-  for (int q = 0; q < 6; q++) free(mags[q]);
-  free(S->wth);
   memset(S, 0, sizeof(*S));
 }
 
@@ -273,6 +238,54 @@ void fesd__system_set_N(fesd__system *S, int N) {
 int fesd__system_nnz(const fesd__system *S) { return S->nnz; }
 void fesd__system_pattern(const fesd__system *S, int *row, int *col) { emit_pattern(S, row, col); }
 
+/* The system's arrays for N_cap elements in one block (common/block.h). */
+static void lay_out(fesd__system *S, int sens, fesd__block *B) {
+  const fesd__model *m = S->model;
+  const int s = S->s, nx = S->nx, nth = S->nth, nsys = S->nsys, nu = S->nu, N = S->N_cap;
+  S->el = fesd__block_take(B, (size_t)N * sizeof(int), 0);
+  S->xo = fesd__block_take(B, (size_t)N * sizeof(int), 0);
+  S->ho = fesd__block_take(B, (size_t)N * sizeof(int), 0);
+  S->lbo = fesd__block_take(B, (size_t)N * sizeof(int), 0);
+  S->rel = fesd__block_take(B, (size_t)N * sizeof(int), 0);
+  S->rlb = fesd__block_take(B, (size_t)N * sizeof(int), 0);
+  S->rx = fesd__block_take(B, (size_t)N * sizeof(int), 0);
+  S->wG = fesd__block_take(B, (size_t)nsys * sizeof(double), 0);
+  S->magX = fesd__block_take(B, ((size_t)nx) * sizeof(double), 1);
+  S->magV = fesd__block_take(B, ((size_t)nx) * sizeof(double), 1);
+  S->refX = fesd__block_take(B, ((size_t)nx) * sizeof(double), 1);
+  S->refV = fesd__block_take(B, ((size_t)nx) * sizeof(double), 1);
+  S->magG = fesd__block_take(B, ((size_t)nsys) * sizeof(double), 1);
+  S->refG = fesd__block_take(B, ((size_t)nsys) * sizeof(double), 1);
+  S->wth = fesd__block_take(B, (size_t)nth * sizeof(double), 0);
+  S->exit_ext = fesd__block_take(B, (size_t)(N + 1) * sizeof(int), 0);
+  S->lbm = fesd__block_take(B, (size_t)N * nth + 1, 0);
+  int np = N * s + N;
+  size_t nu1 = (size_t)(nu > 0 ? nu : 1), pf = (size_t)(m->pf_nnz > 0 ? m->pf_nnz : 1);
+  S->pe = fesd__block_take(B, ((size_t)np) * sizeof(*S->pe), 1);
+  S->X = fesd__block_take(B, (size_t)np * nx * sizeof(double), 0);
+  S->Jth = fesd__block_take(B, (size_t)N * s * pf * sizeof(double), 0);
+  S->JK = fesd__block_take(B, (size_t)N * s * nx * sizeof(double), 0);
+  S->KG = fesd__block_take(B, (size_t)N * s * nth * sizeof(double), 0);
+  S->Juth = fesd__block_take(B, (size_t)N * s * nx * nu1 * sizeof(double), 0);
+  S->lam00_dp = fesd__block_take(B, (sens ? (size_t)nth * (nx + nu) : 1) * sizeof(double), 0); /* O(n^2) */
+  S->tmp = fesd__block_take(B, (size_t)(4 * nx + 2 * nth) * sizeof(double), 0);
+  S->pc_z = fesd__block_take(B, (size_t)N * S->eb * sizeof(double), 0);
+  S->pc_xu = fesd__block_take(B, (size_t)(nx + nu) * sizeof(double), 0);
+  S->pt_X = fesd__block_take(B, (size_t)N * s * nx * sizeof(double) + 1, 0);
+  S->pt_t = fesd__block_take(B, (size_t)N * s * sizeof(double), 0);
+  S->pt_lvl = fesd__block_take(B, ((size_t)N * s) * 1, 1);
+  S->pt_u = fesd__block_take(B, ((size_t)nu + 1) * sizeof(double), 1); /* compared before the first record */
+  fesd__point_eval probe; /* the sizing pass has no S->pe */
+  for (int p = 0; p < np; p++) fesd__point_take(m, S->pe ? &S->pe[p] : &probe, p < N * s, B);
+  if (S->look) {
+    S->LK = fesd__block_take(B, (size_t)N * nth * sizeof(double), 0);
+    S->dgl = fesd__block_take(B, (size_t)N * (m->ndg > 0 ? m->ndg : 1) * sizeof(double), 0);
+    S->dgul = fesd__block_take(B, (size_t)N * nth * nu1 * sizeof(double), 0);
+    S->xs = fesd__block_take(B, (size_t)nx * sizeof(double), 0);
+    fesd__point_take(m, &S->pl, 0, B);
+  }
+}
+
 int fesd__system_init(fesd__system *S, fesd__model *m, const fesd_tableau *tab, int N_cap, int sens) {
   memset(S, 0, sizeof(*S));
   S->model = m;
@@ -293,31 +306,16 @@ int fesd__system_init(fesd__system *S, fesd__model *m, const fesd_tableau *tab, 
       if (q != j) l *= (1.0 - tab->c[q]) / (tab->c[j] - tab->c[q]);
     S->ext[j] = l;
   }
-  const int s = S->s, nx = S->nx, nth = S->nth, nsys = S->nsys, nu = S->nu, N = N_cap;
+  const int s = S->s, nx = S->nx, nth = S->nth, nsys = S->nsys, N = N_cap;
   S->sb = nx + 2 * nth + nsys;
   S->rs = nx + nth + nsys;
   S->eb = s * S->sb + (S->bp ? nth + nsys : 0) + nx + 1;
   S->erows = s * S->rs + (S->bp ? nth + nsys : 0) + nx;
-  S->el = malloc((size_t)N * sizeof(int));
-  S->xo = malloc((size_t)N * sizeof(int));
-  S->ho = malloc((size_t)N * sizeof(int));
-  S->lbo = malloc((size_t)N * sizeof(int));
-  S->rel = malloc((size_t)N * sizeof(int));
-  S->rlb = malloc((size_t)N * sizeof(int));
-  S->rx = malloc((size_t)N * sizeof(int));
-  S->wG = malloc((size_t)nsys * sizeof(double));
-  S->magX = calloc((size_t)nx, sizeof(double));
-  S->magV = calloc((size_t)nx, sizeof(double));
-  S->refX = calloc((size_t)nx, sizeof(double));
-  S->refV = calloc((size_t)nx, sizeof(double));
-  S->magG = calloc((size_t)nsys, sizeof(double));
-  S->refG = calloc((size_t)nsys, sizeof(double));
-  S->wth = malloc((size_t)nth * sizeof(double));
-  S->exit_ext = malloc((size_t)(N + 1) * sizeof(int));
-  S->lbm = malloc((size_t)N * nth + 1);
-  if (!S->exit_ext || !S->lbm || !S->el || !S->xo || !S->ho || !S->lbo || !S->rel || !S->rlb || !S->rx || !S->wG || !S->wth ||
-      !S->magX || !S->magV || !S->refX || !S->refV || !S->magG || !S->refG)
-    goto nomem;
+  fesd__block B = {0};
+  lay_out(S, sens, &B); /* sizing pass */
+  S->mem = fesd__block_open(&B);
+  if (!S->mem) goto nomem;
+  lay_out(S, sens, &B);
   for (int k = 0; k < nsys; k++) S->wG[k] = 1.0;
   for (int i = 0; i < nth; i++) S->wth[i] = 1.0;
   for (int k = 0; k <= N; k++) S->exit_ext[k] = -1;
@@ -342,34 +340,6 @@ int fesd__system_init(fesd__system *S, fesd__model *m, const fesd_tableau *tab, 
     row += nx;
     S->ho[n] = off;
     off += 1;
-  }
-  int np = N * s + N;
-  size_t nu1 = (size_t)(nu > 0 ? nu : 1), pf = (size_t)(m->pf_nnz > 0 ? m->pf_nnz : 1);
-  S->pe = calloc((size_t)np, sizeof(*S->pe));
-  S->X = malloc((size_t)np * nx * sizeof(double));
-  S->Jth = malloc((size_t)N * s * pf * sizeof(double));
-  S->JK = malloc((size_t)N * s * nx * sizeof(double));
-  S->KG = malloc((size_t)N * s * nth * sizeof(double));
-  S->Juth = malloc((size_t)N * s * nx * nu1 * sizeof(double));
-  S->lam00_dp = malloc((sens ? (size_t)nth * (nx + nu) : 1) * sizeof(double)); /* O(n^2) */
-  S->tmp = malloc((size_t)(4 * nx + 2 * nth) * sizeof(double));
-  S->pc_z = malloc((size_t)N * S->eb * sizeof(double));
-  S->pc_xu = malloc((size_t)(nx + nu) * sizeof(double));
-  S->pt_X = malloc((size_t)N * s * nx * sizeof(double) + 1);
-  S->pt_t = malloc((size_t)N * s * sizeof(double));
-  S->pt_lvl = calloc((size_t)N * s, 1);
-  S->pt_u = calloc((size_t)nu + 1, sizeof(double)); /* compared before the first record */
-  if (!S->pc_z || !S->pc_xu || !S->pt_X || !S->pt_t || !S->pt_lvl || !S->pt_u) goto nomem;
-  if (!S->pe || !S->X || !S->Jth || !S->JK || !S->KG || !S->Juth || !S->lam00_dp || !S->tmp)
-    goto nomem;
-  for (int p = 0; p < np; p++)
-    if (fesd__point_alloc(m, &S->pe[p], p < N * s)) goto nomem;
-  if (S->look) {
-    S->LK = malloc((size_t)N * nth * sizeof(double));
-    S->dgl = malloc((size_t)N * (m->ndg > 0 ? m->ndg : 1) * sizeof(double));
-    S->dgul = malloc((size_t)N * nth * nu1 * sizeof(double));
-    S->xs = malloc((size_t)nx * sizeof(double));
-    if (!S->LK || !S->dgl || !S->dgul || !S->xs || fesd__point_alloc(m, &S->pl, 0)) goto nomem;
   }
   fesd__system_set_N(S, N_cap);
   S->wraw = malloc((size_t)S->n_raw * sizeof(double));

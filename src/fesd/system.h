@@ -34,6 +34,7 @@
 #include "fesd_rk.h"
 
 typedef struct {
+  void *mem; /* the block of the arrays below but wraw (lay_out, system.c) */
   int N, N_cap, s, nx, nth, nsys, nu, bp;
   fesd_tableau tab;
   fesd__model *model;
