@@ -5,8 +5,8 @@
  *        classic explicit methods for s = 1..4.
  *
  * Collocation tableaus are computed, not typed in: nodes from the zeros of
- * the orthogonal (Jacobi) polynomials by Golub-Welsch (LAPACK dstev) refined
- * by Newton, A and b by exact quadrature of the Lagrange basis. Accuracy of
+ * the orthogonal (Jacobi) polynomials by Aberth-Ehrlich iteration (Golub-Welsch
+ * with LAPACK dstev as fallback) refined by Newton, A and b by exact quadrature of the Lagrange basis. Accuracy of
  * the entries: a few ulps (the order conditions hold to ~1e-15).
  */
 #ifndef FESD_RK_H

@@ -1,10 +1,19 @@
 /* One allocation for the many arrays of a workspace (block.h). */
 #include "common/block.h"
 
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
+/* AddressSanitizer: gcc defines __SANITIZE_ADDRESS__, clang answers __has_feature */
 #if defined(__SANITIZE_ADDRESS__)
+#define BLOCK_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define BLOCK_ASAN 1
+#endif
+#endif
+#ifdef BLOCK_ASAN
 #include <sanitizer/asan_interface.h>
 #define BLOCK_REDZONE 64
 #else
@@ -13,13 +22,20 @@
 
 enum { BLOCK_ALIGN = 64 }; /* offsets from the base (malloc's alignment, 16, for the base) */
 
-static size_t round_up(size_t n) { return (n + BLOCK_ALIGN - 1) / BLOCK_ALIGN * BLOCK_ALIGN; }
+/* n rounded up to the alignment; SIZE_MAX when that overflows (malloc then fails) */
+static size_t round_up(size_t n) {
+  return n > SIZE_MAX - BLOCK_ALIGN ? SIZE_MAX : (n + BLOCK_ALIGN - 1) / BLOCK_ALIGN * BLOCK_ALIGN;
+}
 
 void *fesd__block_take(fesd__block *b, size_t bytes, int zero) {
-  if (bytes == 0) bytes = 1;
-  const size_t at = b->used;
-  b->used = at + round_up(bytes + BLOCK_REDZONE);
+  if (bytes < sizeof(double)) bytes = sizeof(double); /* as calloc(1, sizeof(double)) did */
+  const size_t at = b->used, step = round_up(bytes > SIZE_MAX - BLOCK_REDZONE ? SIZE_MAX : bytes + BLOCK_REDZONE);
+  b->used = at > SIZE_MAX - step ? SIZE_MAX : at + step; /* saturates: the block's malloc fails */
   if (!b->base) return NULL;
+  if (b->used > b->cap) { /* more than the sizing pass asked for: a layout bug, never memory past the block */
+    b->over = 1;
+    return NULL;
+  }
   char *p = b->base + at;
 #if BLOCK_REDZONE
   ASAN_UNPOISON_MEMORY_REGION(p, bytes);
@@ -31,12 +47,16 @@ void *fesd__block_take(fesd__block *b, size_t bytes, int zero) {
 void *fesd__block_open(fesd__block *b) {
   const size_t size = b->used > 0 ? b->used : 1;
   b->used = 0;
-  b->base = malloc(size); /* malloc (not aligned_alloc): one allocator for every workspace */
+  b->cap = size;
+  b->over = 0;
+  b->base = size == SIZE_MAX ? NULL : malloc(size); /* malloc: one allocator for every workspace */
 #if BLOCK_REDZONE
   if (b->base) ASAN_POISON_MEMORY_REGION(b->base, size);
 #endif
   return b->base;
 }
+
+int fesd__block_ok(const fesd__block *b) { return b->base && !b->over && b->used <= b->cap; }
 
 /* ASan's free re-poisons the whole chunk as freed, red zones included */
 void fesd__block_free(void *base) { free(base); }

@@ -1,4 +1,3 @@
-#include "common/block.h"
 #include "fesd/integrator.h"
 
 #include <math.h>
@@ -262,7 +261,7 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
     double d = 1;
     for (int m = 0; m < tab.s; m++)
       if (m != j) d *= tab.c[j] - tab.c[m];
-    it->lag_inv[j] = d != 0 ? 1 / d : 0; /* 0: repeated nodes (explicit RK), no polynomial */
+    it->lag_inv[j] = d != 0 ? 1 / d : 0; /* explicit RK: no collocation polynomial, not used */
   }
   fesd_tableau_get(FESD_RK_GAUSS_LEGENDRE, tab.s, &it->quad);
   fesd__interior_setup(it);
@@ -279,7 +278,7 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   lay_out(it, settings, &B); /* sizing pass */
   it->mem = fesd__block_open(&B);
   if (it->mem) lay_out(it, settings, &B);
-  int fail = !it->mem;
+  int fail = !fesd__block_ok(&B);
   int max_nf = 0;
   for (int k = 0; k < it->nsys; k++) max_nf = it->model.nf[k] > max_nf ? it->model.nf[k] : max_nf;
   it->ev_span = 2 * max_nf;

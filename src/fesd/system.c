@@ -316,6 +316,7 @@ int fesd__system_init(fesd__system *S, fesd__model *m, const fesd_tableau *tab, 
   S->mem = fesd__block_open(&B);
   if (!S->mem) goto nomem;
   lay_out(S, sens, &B);
+  if (!fesd__block_ok(&B)) goto nomem;
   for (int k = 0; k < nsys; k++) S->wG[k] = 1.0;
   for (int i = 0; i < nth; i++) S->wth[i] = 1.0;
   for (int k = 0; k <= N; k++) S->exit_ext[k] = -1;

@@ -48,8 +48,9 @@ static void eval_monic(int n, const double *ak, const double *bk, double x, doub
  * machine-constant queries costs ~15k instructions, this ~2k, and every fesd_create builds two
  * tableaus. The iteration converges cubically: it stops after the sweep whose steps are all
  * below 1e-9 (the next would be at round-off; the caller's Newton polishing finishes). Returns 0
- * unless it stopped so and the zeros, sorted, are distinct inside (0, 1) (the caller then uses
- * the eigensolver). */
+ * unless it stopped so, the zeros, sorted, are distinct inside (0, 1) and their sum is the
+ * trace of the Jacobi matrix, sum ak (two starts on one zero would leave another out); the
+ * caller then uses the eigensolver. */
 static int aberth_zeros(int n, const double *ak, const double *bk, double *x) {
   const double pi = 3.14159265358979323846;
   for (int i = 0; i < n; ++i) x[i] = 0.5 - 0.5 * cos(pi * (i + 0.5) / n);
@@ -74,25 +75,31 @@ static int aberth_zeros(int n, const double *ak, const double *bk, double *x) {
       x[j] = x[j - 1];
       x[j - 1] = t;
     }
+  double sx = 0.0, sa = 0.0;
+  for (int i = 0; i < n; ++i) sx += x[i], sa += ak[i];
   for (int i = 0; i + 1 < n; ++i)
     if (!(x[i] < x[i + 1])) return 0;
-  return x[0] > 0.0 && x[n - 1] < 1.0;
+  return x[0] > 0.0 && x[n - 1] < 1.0 && fabs(sx - sa) <= 1e-8;
 }
 
-int fesd__jacobi_zeros01(int n, double alpha, double beta, double *x) {
+/* Golub-Welsch: the zeros are the eigenvalues of the symmetric tridiagonal Jacobi matrix with
+ * diagonal ak and off-diagonal sqrt(bk[1..n-1]) (LAPACK dstev, ascending). */
+static int eigen_zeros(int n, const double *ak, const double *bk, double *x) {
+  double e[FESD_RK_MAX_STAGES], zdummy[1], wdummy[1];
+  for (int k = 0; k < n; ++k) x[k] = ak[k];
+  for (int k = 0; k + 1 < n; ++k) e[k] = sqrt(bk[k + 1]);
+  int info = 0, ldz = 1;
+  dstev_("N", &n, x, e, zdummy, &ldz, wdummy, &info, 1);
+  return info == 0 ? FESD_OK : FESD_ERR_LINSOLVE;
+}
+
+int fesd__jacobi_zeros01_by(int n, double alpha, double beta, int eigen, double *x) {
   if (n <= 0) return FESD_OK;
   double ak[FESD_RK_MAX_STAGES], bk[FESD_RK_MAX_STAGES];
   jacobi_recurrence01(n, alpha, beta, ak, bk);
-
-  if (!aberth_zeros(n, ak, bk, x)) {
-    /* Golub-Welsch: the zeros are the eigenvalues of the symmetric tridiagonal
-     * Jacobi matrix with diagonal ak and off-diagonal sqrt(bk[1..n-1]). */
-    double e[FESD_RK_MAX_STAGES], zdummy[1], wdummy[1];
-    for (int k = 0; k < n; ++k) x[k] = ak[k];
-    for (int k = 0; k + 1 < n; ++k) e[k] = sqrt(bk[k + 1]);
-    int info = 0, ldz = 1;
-    dstev_("N", &n, x, e, zdummy, &ldz, wdummy, &info, 1);
-    if (info != 0) return FESD_ERR_LINSOLVE;
+  if (eigen || !aberth_zeros(n, ak, bk, x)) {
+    int rc = eigen_zeros(n, ak, bk, x);
+    if (rc != FESD_OK) return rc;
   }
 
   /* Newton polishing: either way the zeros are accurate to ~ eps already,
@@ -118,6 +125,10 @@ int fesd__jacobi_zeros01(int n, double alpha, double beta, double *x) {
     if (n % 2 == 1) x[n / 2] = 0.5;
   }
   return FESD_OK;
+}
+
+int fesd__jacobi_zeros01(int n, double alpha, double beta, double *x) {
+  return fesd__jacobi_zeros01_by(n, alpha, beta, 0, x);
 }
 
 int fesd__gauss_legendre01(int n, double *x, double *w) {

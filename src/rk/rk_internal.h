@@ -9,12 +9,16 @@
 
 /* Zeros (ascending) on [0,1] of the degree-n polynomial orthogonal w.r.t. the
  * weight (1-x)^alpha * x^beta (a shifted Jacobi polynomial), alpha, beta > -1.
- * Golub-Welsch (LAPACK dstev on the Jacobi matrix of the closed-form
- * recurrence coefficients) followed by Newton polishing on the three-term
- * recurrence. Symmetric weights (alpha == beta) give exactly symmetric zeros
- * (x[n-1-i] = 1 - x[i]; the middle zero of odd n is exactly 1/2).
+ * Aberth-Ehrlich iteration on the closed-form three-term recurrence from
+ * Chebyshev points, Golub-Welsch (LAPACK dstev on the Jacobi matrix) where it
+ * does not settle, then Newton polishing on the recurrence. Symmetric weights
+ * (alpha == beta) give exactly symmetric zeros (x[n-1-i] = 1 - x[i]; the
+ * middle zero of odd n is exactly 1/2).
  * 0 <= n <= FESD_RK_MAX_STAGES. Returns FESD_OK or FESD_ERR_LINSOLVE. */
 int fesd__jacobi_zeros01(int n, double alpha, double beta, double *x);
+/* The same by Golub-Welsch alone when eigen != 0 (the fallback, and an independent
+ * computation for the tests). */
+int fesd__jacobi_zeros01_by(int n, double alpha, double beta, int eigen, double *x);
 
 /* n-point Gauss-Legendre rule on [0,1] (exact for degree 2n-1): nodes from
  * fesd__jacobi_zeros01(n, 0, 0), weights from the Christoffel function

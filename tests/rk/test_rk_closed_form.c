@@ -7,6 +7,7 @@
 #include <stdio.h>
 
 #include "fesd_rk.h"
+#include "rk/rk_internal.h"
 
 #define TOL 1e-14
 #define S_MAX 4
@@ -76,6 +77,24 @@ int main(void) {
   };
   int failures = 0;
   for (size_t k = 0; k < sizeof refs / sizeof refs[0]; ++k) failures += compare(&refs[k]);
+  /* The nodes of every s: the Aberth-Ehrlich path against Golub-Welsch (LAPACK's eigensolver,
+   * the fallback), both polished by the same Newton steps on the recurrence. */
+  const double wts[3][2] = {{0, 0}, {1, 0}, {1, 1}}; /* Gauss, Radau, Lobatto interiors */
+  double worst = 0;
+  for (int w = 0; w < 3; ++w)
+    for (int n = 1; n <= FESD_RK_MAX_STAGES; ++n) {
+      double xa[FESD_RK_MAX_STAGES], xe[FESD_RK_MAX_STAGES];
+      if (fesd__jacobi_zeros01_by(n, wts[w][0], wts[w][1], 0, xa) ||
+          fesd__jacobi_zeros01_by(n, wts[w][0], wts[w][1], 1, xe)) {
+        printf("FAIL zeros n=%d (%g, %g): a path failed\n", n, wts[w][0], wts[w][1]);
+        failures++;
+        continue;
+      }
+      for (int i = 0; i < n; ++i) worst = fmax(worst, fabs(xa[i] - xe[i]));
+    }
+  printf("Jacobi zeros, Aberth-Ehrlich against Golub-Welsch, n = 1..%d, three weights: max |diff| %.1e (tolerance 1e-15)\n",
+         FESD_RK_MAX_STAGES, worst);
+  if (!(worst <= 1e-15)) failures++;
   printf("%s (%d failures, tolerance %.0e)\n", failures ? "FAILED" : "PASSED", failures, TOL);
   return failures ? 1 : 0;
 }
