@@ -142,7 +142,10 @@ typedef struct {
   int n_fe;                 /**< finite elements per step: [2, 1000] for FESD, [1, 1000] for
                                  the standard method (default 2) */
   double newton_tol;        /**< ||F||_inf tolerance of every step solve, [1e-16, 1e-3]
-                                 (default 1e-12; a loose tolerance lets sum h miss T) */
+                                 (default 1e-12; a loose tolerance lets sum h miss T). Under
+                                 error control (fesd_integrate*) a step's solves use
+                                 min(newton_tol, max(1e-14, 0.1 min_r (atol_r + rtol |x_r|) /
+                                 |x|_inf)): the estimate must not see the solve's noise */
   int max_iter_first;       /**< iterations of the first (equal-h) attempt, [1, 1000] (default 12) */
   int max_iter;             /**< iterations of the switch solves, [1, 1000] (default 40) */
   double cc_tol;            /**< tolerance on every cross-complementarity product

@@ -329,7 +329,7 @@ static int ambiguous_side(fesd_integrator *it, const double *z) {
          * the equations' own resolution (newton_tol, relative), where a zero gap (a switch on
          * the element boundary) shows as round-off of either sign (measured 1e-35 and -7e-17
          * weighted at legitimate entries; -1.6e-11 to -1.8e-10 past the Zeno point) */
-        const double w = S->wth[q], l0 = lam0[q], lo = -it->set.newton_tol;
+        const double w = S->wth[q], l0 = lam0[q], lo = -it->newton_tol;
         int band = fabs(l0) * w <= it->set.cc_tol, wrong = l0 * w < lo;
         for (int j = 0; j < s && band; j++) {
           if (S->tab.c[j] == 0.0) continue; /* Lobatto's first stage lies O(h^2) off the start */

@@ -230,6 +230,7 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   fesd_integrator *it = calloc(1, sizeof(*it));
   if (!it) return FESD_ERR_NOMEM;
   it->set = *settings;
+  it->newton_tol = settings->newton_tol;
   if (model->nsys >= 1 && model->n_modes)
     for (int k = 0; k < model->nsys; k++)
       if (model->n_modes[k] < 2) {

@@ -152,7 +152,7 @@ static int solve(fesd_integrator *it, double *z, double sigma, double tol, int m
 /* z0 holds the initial guess (N_FE layout); on success z is a converged solution. */
 static int fb_path(fesd_integrator *it, double T, fesd_step_info *info) {
   fesd__system *S = &it->sys;
-  const double tol = it->set.newton_tol;
+  const double tol = it->newton_tol;
   double *z = it->z, *z0 = it->z0, *zp = it->zpred;
   int st;
   if ((st = rows_select(it, NULL))) return st;
@@ -207,7 +207,7 @@ static int fb_path(fesd_integrator *it, double T, fesd_step_info *info) {
 int fesd__fixed_solve(fesd_integrator *it, double *z, int max_iter, int slow_iter, fesd_step_info *info) {
   int st = fesd__rows_active(it, it->act, it->bmode, it->exit_mode);
   if (st) return st;
-  st = solve(it, z, 0.0, it->set.newton_tol, max_iter, 0, slow_iter, info);
+  st = solve(it, z, 0.0, it->newton_tol, max_iter, 0, slow_iter, info);
   if (st) return st;
   for (int n = 0; n < it->sys.N; n++)
     if (!(z[it->sys.ho[n]] > 0)) return FESD_ERR_STEP_FAILED;
@@ -228,7 +228,7 @@ static int certified(fesd_integrator *it, fesd_step_info *info) {
   const fesd__model *m = S->model;
   /* the rows that hold by construction do so to a few eps per term: the sum of the N lengths
    * against T to about N eps, x_{n+1} to about s eps; below that newton_tol is the solver's */
-  if (it->full_check || S->look || it->set.newton_tol < 64.0 * (S->N + S->s) * DBL_EPSILON) return 0;
+  if (it->full_check || S->look || it->newton_tol < 64.0 * (S->N + S->s) * DBL_EPSILON) return 0;
   for (int k = 0; k < S->nsys; k++) {
     int cnt = 0;
     for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) cnt += it->act0[i] != 0;
@@ -245,7 +245,7 @@ static int certified(fesd_integrator *it, fesd_step_info *info) {
       fesd__stage_residual(m, pe, v, th, g);
       for (int r = 0; r < S->nx; r++) res = fesd__fmax(res, fabs(g[r] * wv[r]));
     }
-  if (!(res <= it->set.newton_tol)) return 0;
+  if (!(res <= it->newton_tol)) return 0;
   info->residual = res;
   info->solves++;
   it->n_certified++;
