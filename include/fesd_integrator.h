@@ -221,7 +221,10 @@ typedef struct {
                                      side decided below the resolution of the sign checks, while
                                      the other side's field would have moved the state by more
                                      than the tolerances: the state may be off (e.g. just past a
-                                     Zeno accumulation) */
+                                     Zeno accumulation); or the step's events hold two switches of
+                                     one subsystem less than 1e-9 max(1, |t|) apart (a phase of
+                                     zero length, e.g. exit, re-entry, exit at one instant): their
+                                     order is not resolved */
 
 /** Statistics of one fesd_step() (accumulated over sub-steps when it splits). */
 typedef struct {

@@ -257,11 +257,23 @@ static int subset(const int *a, int na, const int *b, int nb) {
   return 1;
 }
 
+/* Two switches of one subsystem closer than this (relative to max(1, |t|)) make a phase of
+ * numerically zero length. */
+#define ZERO_PHASE 1e-9
+
 /* Record a switch of subsystem k at t if the active sets differ; before (nb) and after (na)
  * lie in the room given by event_room, after = before + nb. */
 static void add_event(fesd_integrator *it, double t, int k, const int *before, int nb, int na) {
   const int *after = before + nb;
   if (nb == na && !memcmp(before, after, (size_t)nb * sizeof(int))) return;
+  /* A second switch of the subsystem at the same instant (a phase of zero length: measured, an
+   * exit, a re-entry and an exit within 2e-12 after six halvings of a Lobatto IIIC step, where
+   * one exit was right) is an order decided below the resolution of the checks: flagged */
+  for (int i = it->n_events - 1; i >= 0; i--)
+    if (it->events[i].sys == k) {
+      if (t - it->events[i].t <= ZERO_PHASE * fmax(1.0, fabs(t))) it->step_flags |= FESD_FLAG_AMBIGUOUS;
+      break;
+    }
   fesd_event *e = &it->events[it->n_events++];
   e->t = t;
   e->sys = k;
