@@ -215,8 +215,11 @@ typedef struct {
                                      Gauss-Legendre): its time is not determined by the equations
                                      and does not converge with h (docs/sliding_exit.md) */
 #define FESD_FLAG_COARSE 0x8    /**< the step's local error estimate exceeds its tolerance
-                                     (settings.coarse_tol, relative): the step is too long for the
-                                     accuracy of the solution */
+                                     (settings.coarse_tol, relative), or (stiffly accurate
+                                     families) an element is longer than twice the time in which
+                                     the field expands along its increment, where an L-stable
+                                     method damps a growing mode and its estimate with it: the
+                                     step is too long for the accuracy of the solution */
 #define FESD_FLAG_AMBIGUOUS 0x10 /**< a subsystem ran along one of its surfaces in one mode, its
                                      side decided below the resolution of the sign checks, while
                                      the other side's field would have moved the state by more

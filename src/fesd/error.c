@@ -90,6 +90,10 @@ int fesd__error_estimate(fesd_integrator *it, const double *z, double rtol, cons
       }
       const fesd__point_eval *pr = n > 0 ? fesd__system_record(S, n * s - 1, tn, xn, slide ? 2 : 1) : NULL;
       fesd__point_eval pe = {0};
+      if (!pr && n == 0 && !slide && it->f0_ok) { /* the guess evaluated the fields there */
+        pe.F = it->f0;
+        pr = &pe;
+      }
       if (!pr) {
         pe.F = it->pscr.F;
         pe.dgdx = slide ? it->pscr.dgdx : NULL;

@@ -203,6 +203,7 @@ static void lay_out(fesd_integrator *it, const fesd_settings *settings, fesd__bl
   it->slide_tmp = fesd__block_doubles(B, 2 * nx);
   it->fil_a = fesd__block_take(B, nth, 0);
   fesd__point_take(&it->model, &it->pscr, 1, B);
+  it->f0 = fesd__block_doubles(B, (size_t)(it->model.nF > 0 ? it->model.nF : 1));
   const int gq = s * nx; /* the guess's stage Newton: small systems only */
   if (gq <= FESD__GN_MAX && !it->tab.is_explicit) {
     it->gn = fesd__block_doubles(B, (size_t)gq * gq + 2 * (size_t)gq + (size_t)nx * nx);

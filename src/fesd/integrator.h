@@ -81,6 +81,8 @@ struct fesd_integrator {
   double t_c; /* compensation of the sum of the step lengths (t is their Kahan sum) */
   void *mem; /* the block of the arrays below that do not grow (lay_out, integrator.c) */
   double newton_tol; /* of the step solves: settings.newton_tol, tighter under error control */
+  double *f0;  /* the fields at the step start (nF), when f0_ok: from the guess's stage Newton */
+  int f0_ok;   /* reset at each step attempt (try_step) */
   double *x, *lam00, *theta_prev, *u_cur, *ws_blk; /* ws_blk: last stage block of the last step */
   int have_state, have_ws, have_prev_theta;
   /* step data (sized for N_cap elements) */

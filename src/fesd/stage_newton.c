@@ -37,6 +37,10 @@ static int stage_key(fesd_integrator *it, const double *z, int n, const double *
   } else if (fesd__model_eval(m, tn, xn, S->u, pj)) {
     return 1;
   }
+  if (n == 0 && pj->F && xn == S->x0 && tn == S->t0) { /* the fields at the step start, for the */
+    memcpy(it->f0, pj->F, (size_t)m->nF * sizeof(double)); /* error estimate's f_0 (error.c) */
+    it->f0_ok = 1;
+  }
   it->gn_key[0] = h;
   for (int j = 0; j < S->s; j++) {
     double *J = it->gn_key + 1 + (size_t)j * nnz;

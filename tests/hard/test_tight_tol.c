@@ -18,7 +18,13 @@
  * placed 3e-4 to 3e-3 off, a documented limit): every event of a step not flagged
  * FESD_FLAG_AMBIGUOUS is within 5e-3 of a reference event of its kind, and every reference event
  * is reported. Before the zero-length-phase flag one step logged exit, entry, exit within 2e-12
- * of 18.3123 unflagged (the reference has one exit there). */
+ * of 18.3123 unflagged (the reference has one exit there).
+ * Third part, the coarse-step flag: the inside field alone (x' = [a -2; 2 a] x, the surface far
+ * away), fixed steps of h, every step compared with the exact flow e^{ah} R(2h) from its start:
+ * a step whose local error exceeds 0.1 |x| must carry FESD_FLAG_COARSE (a = 1, h = 5.3: the
+ * L-stable methods damp the growing focus and their embedded estimate with it; before the
+ * growth check of step.c one such step with a local error of 0.50 passed unflagged), and no
+ * step is flagged where h is small (h = 0.05, a = +-1). */
 #include "hard_util.h"
 
 static int field(int sys, int mode, double t, const double *x, const double *u, double *f, void *user) {
@@ -134,6 +140,65 @@ static int fixed_step_log(const fesd_model *m, double t_in, double t_out, double
   return fails;
 }
 
+static double focus_a; /* growth rate of the focus */
+static int focus(int sys, int mode, double t, const double *x, const double *u, double *f, void *user) {
+  (void)sys, (void)mode, (void)t, (void)u, (void)user;
+  f[0] = focus_a * x[0] - 2 * x[1];
+  f[1] = 2 * x[0] + focus_a * x[1];
+  return 0;
+}
+static int far_sw(int sys, double t, const double *x, const double *u, double *c, void *user) {
+  (void)sys, (void)t, (void)u, (void)user;
+  c[0] = x[0] - 1e300; /* never reached: mode 1 throughout */
+  return 0;
+}
+
+static int coarse_flags(void) {
+  int fails = 0;
+  const int nm[1] = {2}, ns[1] = {1};
+  fesd_model m = {.nx = 2, .nsys = 1, .n_modes = nm, .n_switch = ns, .field = focus, .sw = far_sw};
+  const struct { fesd_rk_family fam; int s; } fam[] = {
+      {FESD_RK_RADAU_IIA, 2}, {FESD_RK_RADAU_IIA, 3}, {FESD_RK_LOBATTO_IIIC, 2}, {FESD_RK_LOBATTO_IIIC, 3}};
+  const double as[3] = {1, 1, -1}, hs[3] = {5.3, 0.05, 0.05};
+  for (int c = 0; c < 3; c++)
+    for (size_t f = 0; f < sizeof fam / sizeof fam[0]; f++) {
+      focus_a = as[c];
+      fesd_settings set;
+      fesd_settings_default(&set);
+      set.family = fam[f].fam;
+      set.stages = fam[f].s;
+      fesd_integrator *it = NULL;
+      const double x0[2] = {1e-3, 2e-3};
+      int st = fesd_create(&it, &m, &set);
+      if (!st) st = fesd_set_state(it, 0, x0, NULL);
+      const int nsteps = c == 0 ? 6 : 200;
+      int flagged = 0, bad = 0, missed = 0;
+      for (int k = 0; k < nsteps && !st; k++) {
+        double xa[2], xb[2];
+        fesd_get_state(it, NULL, xa);
+        fesd_step_info si;
+        st = fesd_step(it, NULL, hs[c], &si);
+        if (st) break;
+        fesd_get_state(it, NULL, xb);
+        const double h = hs[c], g = exp(as[c] * h), cs = cos(2 * h), sn = sin(2 * h);
+        const double ex[2] = {g * (cs * xa[0] - sn * xa[1]), g * (sn * xa[0] + cs * xa[1])};
+        const double err = hd_maxdiff(xb, ex, 2), size = fmax(fabs(ex[0]), fabs(ex[1]));
+        const int coarse = (si.flags & FESD_FLAG_COARSE) != 0;
+        flagged += coarse;
+        bad += err > 0.1 * size;
+        missed += err > 0.1 * size && !coarse;
+      }
+      printf("focus a = %+g, h = %g, %s s=%d: %s, %d steps with local error > 0.1 |x|, %d flagged COARSE, %d missed\n",
+             as[c], hs[c], fam[f].fam == FESD_RK_RADAU_IIA ? "Radau IIA" : "Lobatto IIIC", fam[f].s, fesd_status_name(st),
+             bad, flagged, missed);
+      HD_CHECK(st == FESD_OK && missed == 0, "focus a=%g h=%g family %d s=%d: %s, %d inaccurate steps unflagged", as[c], hs[c],
+               (int)fam[f].fam, fam[f].s, fesd_status_name(st), missed);
+      HD_CHECK(c == 0 || flagged == 0, "focus a=%g h=%g: %d steps flagged COARSE at a small step", as[c], hs[c], flagged);
+      fesd_free(&it);
+    }
+  return fails;
+}
+
 int main(void) {
   int fails = 0;
   const double pi = 3.14159265358979323846, T = 3;
@@ -188,6 +253,7 @@ int main(void) {
     fesd_free(&it);
   }
   fails += fixed_step_log(&m, t_in, t_out, phi_e);
+  fails += coarse_flags();
   printf("%s (%d failures)\n", fails ? "FAILED" : "PASSED", fails);
   return fails ? 1 : 0;
 }
