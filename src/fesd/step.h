@@ -126,6 +126,9 @@ int fesd__error_setup(fesd_integrator *it);
 /* Local error estimate of the solution z of the current layout: weighted RMS norm of the
  * embedded difference with weights 1 / (atol_r + rtol max|x|), max over the elements. */
 int fesd__error_estimate(fesd_integrator *it, const double *z, double rtol, const double *atol, double *err);
+/* FESD_FLAG_COARSE for the solution it->z of a fixed step: the estimate against coarse_tol, or
+ * an element that outgrew its field (L-stable damping of a growing mode). */
+int fesd__coarse_check(fesd_integrator *it, fesd_step_info *info);
 
 /* ---- accept.c ---- */
 int fesd__accept(fesd_integrator *it, const double *z, const double *u, double T);
