@@ -155,7 +155,9 @@ typedef struct {
                                  (default 1e-6) */
   int exit_rows;            /**< 1: pin sliding exits (beyond the paper, docs/sliding_exit.md);
                                  0: the paper's formulation (default 1) */
-  int max_splits;           /**< recursive halvings of a failed step, [0, 12] (default 6) */
+  int max_splits;           /**< recursive halvings of a failed step, [0, 12] (default 6);
+                                 under error control (fesd_integrate*) none: a failed step goes
+                                 back to the step-size controller, which retries it shorter */
   int sensitivities;        /**< 1: propagate dx/dx0 and dx/du; 0: not (default 0) */
   int max_sweeps;           /**< fixed-point sweeps that make the initial guess of a step
                                  consistent, [1, 50] (default 8; they stop early when

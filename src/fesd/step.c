@@ -450,7 +450,11 @@ int fesd__substep(fesd_integrator *it, const double *u, double T, int depth, fes
     info->fallback = fb;
     fesd__load(it, &it->bk_sub); /* accept may have failed half-way */
     if (fesd__hard_failure(st) && st != FESD_ERR_NONFINITE) return st;
-    if (depth >= it->set.max_splits)
+    /* under error control a failed (sub)step goes back to the controller, which retries it
+     * shorter with a new first solve and prediction: halving it here spent hundreds of Newton
+     * iterations on attempts the error test then rejected (Stribeck stick-slip, Radau s = 2,
+     * rtol 1e-3: 2542 -> 405 iterations, 1e-1: 2060 -> 815, 1e-6: 2347 -> 770) */
+    if (depth >= (it->ec_on ? 0 : it->set.max_splits))
       return st == FESD_ERR_TOO_MANY_SWITCHES || st == FESD_ERR_NONFINITE ? st : FESD_ERR_STEP_FAILED;
     info->splits++;
     const double R = T - done, half = 0.5 * R;
