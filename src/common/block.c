@@ -32,10 +32,7 @@ void *fesd__block_take(fesd__block *b, size_t bytes, int zero) {
   const size_t at = b->used, step = round_up(bytes > SIZE_MAX - BLOCK_REDZONE ? SIZE_MAX : bytes + BLOCK_REDZONE);
   b->used = at > SIZE_MAX - step ? SIZE_MAX : at + step; /* saturates: the block's malloc fails */
   if (!b->base) return NULL;
-  if (b->used > b->cap) { /* more than the sizing pass asked for: a layout bug, never memory past the block */
-    b->over = 1;
-    return NULL;
-  }
+  if (b->used > b->cap) return NULL; /* more than the sizing pass asked for: fesd__block_ok says so */
   char *p = b->base + at;
 #if BLOCK_REDZONE
   ASAN_UNPOISON_MEMORY_REGION(p, bytes);
@@ -48,7 +45,6 @@ void *fesd__block_open(fesd__block *b) {
   const size_t size = b->used > 0 ? b->used : 1;
   b->used = 0;
   b->cap = size;
-  b->over = 0;
   b->base = size == SIZE_MAX ? NULL : malloc(size); /* malloc: one allocator for every workspace */
 #if BLOCK_REDZONE
   if (b->base) ASAN_POISON_MEMORY_REGION(b->base, size);
@@ -56,7 +52,7 @@ void *fesd__block_open(fesd__block *b) {
   return b->base;
 }
 
-int fesd__block_ok(const fesd__block *b) { return b->base && !b->over && b->used <= b->cap; }
+int fesd__block_ok(const fesd__block *b) { return b->base && b->used <= b->cap; }
 
 /* ASan's free re-poisons the whole chunk as freed, red zones included */
 void fesd__block_free(void *base) { free(base); }

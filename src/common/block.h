@@ -17,7 +17,6 @@ typedef struct {
   char *base;  /* NULL in the sizing pass */
   size_t used; /* bytes laid out so far (saturates at SIZE_MAX) */
   size_t cap;  /* the block's size (fesd__block_open) */
-  int over;    /* the carving pass asked for more than the sizing pass */
 } fesd__block;
 
 /* Room for `bytes` (at least 8), zeroed when `zero`; NULL in the sizing pass (and past the

@@ -153,7 +153,8 @@ static int outgrown(const fesd_integrator *it) {
 
 /* Flag a step whose local error estimate exceeds coarse_tol, relative to the size of each
  * component (its largest value so far, on this step or before; at least 1e-6 of the largest
- * component): a too coarse step shows without a reference solution. */
+ * component), or one with an element that outgrew its field (above): a too coarse step shows
+ * without a reference solution. */
 int fesd__coarse_check(fesd_integrator *it, fesd_step_info *info) {
   const fesd__system *S = &it->sys;
   double big = 0, *sz = it->err_atol;

@@ -8,6 +8,7 @@
 #include "fesd/step.h"
 #include "ncp/ncp_defer.h"
 #include "ncp/ncp_nomem.h"
+#include "rk/rk_internal.h"
 
 int fesd_settings_default(fesd_settings *s) {
   if (!s) return FESD_ERR_NULL;
@@ -259,12 +260,9 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   }
   fesd__system *S = &it->sys;
   it->tab = tab;
-  for (int j = 0; j < tab.s; j++) {
-    double d = 1;
-    for (int m = 0; m < tab.s; m++)
-      if (m != j) d *= tab.c[j] - tab.c[m];
-    it->lag_inv[j] = d != 0 ? 1 / d : 0; /* explicit RK: no collocation polynomial, not used */
-  }
+  fesd__lagrange_denominators(tab.s, tab.c, it->lag_inv);
+  for (int j = 0; j < tab.s; j++) /* explicit RK (repeated nodes): no collocation polynomial, not used */
+    it->lag_inv[j] = it->lag_inv[j] != 0 ? 1 / it->lag_inv[j] : 0;
   fesd_tableau_get(FESD_RK_GAUSS_LEGENDRE, tab.s, &it->quad);
   fesd__interior_setup(it);
   fesd__error_setup(it);

@@ -26,8 +26,7 @@ int fesd__collocation_nodes(fesd_rk_family family, int s, double *c) {
   }
 }
 
-/* Lagrange basis on the n nodes y: l_j(t) = prod_{k != j} (t - y_k) / den[j]. */
-static void lagrange_denominators(int n, const double *y, double *den) {
+void fesd__lagrange_denominators(int n, const double *y, double *den) {
   for (int j = 0; j < n; ++j) {
     double d = 1.0;
     for (int k = 0; k < n; ++k)
@@ -69,7 +68,7 @@ int fesd__collocation_ab(int s, const double *c,
   int rc = quad_rule_for(s, &q);
   if (rc != FESD_OK) return rc;
   double den[FESD_RK_MAX_STAGES];
-  lagrange_denominators(s, c, den);
+  fesd__lagrange_denominators(s, c, den);
   for (int j = 0; j < s; ++j) b[j] = lagrange_integral(&q, s, c, den, j, 1.0);
   for (int i = 0; i < s; ++i) {
     if (c[i] == 1.0) { /* same integral as b: copy (bit-identical last row) */
@@ -88,14 +87,14 @@ int fesd__lobatto3c_ab(int s, const double *c,
   if (rc != FESD_OK) return rc;
   /* b: the Lobatto weights (integrals of the Lagrange basis on all s nodes). */
   double den[FESD_RK_MAX_STAGES];
-  lagrange_denominators(s, c, den);
+  fesd__lagrange_denominators(s, c, den);
   for (int j = 0; j < s; ++j) b[j] = lagrange_integral(&q, s, c, den, j, 1.0);
 
   /* L_m, m = 2..s: Lagrange basis of degree s-2 on the n = s-1 nodes c_2..c_s. */
   const int n = s - 1;
   const double *y = c + 1;
   double den2[FESD_RK_MAX_STAGES], Lc1[FESD_RK_MAX_STAGES];
-  lagrange_denominators(n, y, den2);
+  fesd__lagrange_denominators(n, y, den2);
   for (int m = 0; m < n; ++m) Lc1[m] = lagrange_eval(n, y, den2, m, c[0]);
   for (int i = 0; i < s - 1; ++i) {
     A[i][0] = b[0];

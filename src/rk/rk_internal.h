@@ -32,6 +32,9 @@ int fesd__gauss_legendre01(int n, double *x, double *w);
  * The caller checks that (family, s) is supported. */
 int fesd__collocation_nodes(fesd_rk_family family, int s, double *c);
 
+/* Lagrange basis on the n nodes y: l_j(t) = prod_{k != j} (t - y_k) / den[j]. */
+void fesd__lagrange_denominators(int n, const double *y, double *den);
+
 /* Collocation A and b on nodes c: A_ij = int_0^{c_i} l_j, b_j = int_0^1 l_j
  * (l_j: Lagrange basis on c), by an exact Gauss-Legendre quadrature. */
 int fesd__collocation_ab(int s, const double *c,

@@ -85,23 +85,20 @@ static inline int hd_integrate(const fesd_model *m, const fesd_settings *set, do
   return r->status = st;
 }
 
-/* An error-controlled run as a user makes it: fesd_integrate from (t0, x0) to T with Radau IIA
- * of `stages` stages, rtol and atol = 1e-3 rtol; the event log into r->ev (r->n_ev), the state
+/* An error-controlled run as a user makes it: fesd_integrate from (t0, x0) to T with the
+ * settings set and tolerances rtol, atol; the event log into r->ev (r->n_ev), the state
  * reached into r->x_end, the statistics into *info. */
-static inline int hd_integrate_tol(const fesd_model *m, int stages, double rtol, double t0, const double *x0,
-                                   double T, hd_run *r, fesd_integrate_info *info) {
+static inline int hd_integrate_set(const fesd_model *m, const fesd_settings *set, double rtol, double atol,
+                                   double t0, const double *x0, double T, hd_run *r, fesd_integrate_info *info) {
   memset(r, 0, sizeof(*r));
   memset(info, 0, sizeof(*info));
-  fesd_settings set;
-  fesd_settings_default(&set);
-  set.stages = stages;
   fesd_integrator *it;
-  int st = fesd_create(&it, m, &set);
+  int st = fesd_create(&it, m, set);
   if (st) return r->status = st;
   fesd_tolerances tol;
   fesd_tolerances_default(&tol);
   tol.rtol = rtol;
-  tol.atol = 1e-3 * rtol;
+  tol.atol = atol;
   st = fesd_set_tolerances(it, &tol);
   if (!st) st = fesd_set_state(it, t0, x0, NULL);
   if (!st) st = fesd_integrate(it, NULL, T, info);
@@ -112,6 +109,15 @@ static inline int hd_integrate_tol(const fesd_model *m, int stages, double rtol,
   fesd_get_state(it, &r->t_end, r->x_end);
   fesd_free(&it);
   return r->status = st;
+}
+
+/* ... with Radau IIA of `stages` stages and atol = 1e-3 rtol. */
+static inline int hd_integrate_tol(const fesd_model *m, int stages, double rtol, double t0, const double *x0,
+                                   double T, hd_run *r, fesd_integrate_info *info) {
+  fesd_settings set;
+  fesd_settings_default(&set);
+  set.stages = stages;
+  return hd_integrate_set(m, &set, rtol, 1e-3 * rtol, t0, x0, T, r, info);
 }
 
 /* Number of element boundaries where some subsystem's active set changes. */

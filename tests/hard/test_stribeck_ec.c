@@ -97,46 +97,32 @@ int main(void) {
   const int nm[1] = {2}, ns[1] = {1};
   fesd_model m = {.nx = 2, .nsys = 1, .n_modes = nm, .n_switch = ns, .field = field, .sw = sw};
   const double rtols[2] = {1e-3, 1e-6};
+  static hd_run R;
   for (int s = 2; s <= 3; s++)
     for (int r = 0; r < 2; r++) {
       fesd_settings set;
       fesd_settings_default(&set);
       set.stages = s;
-      fesd_integrator *it = NULL;
-      int st = fesd_create(&it, &m, &set);
-      fesd_tolerances tol;
-      fesd_tolerances_default(&tol);
-      tol.rtol = tol.atol = rtols[r];
       const double x0[2] = {0, VB};
-      if (!st) st = fesd_set_tolerances(it, &tol);
-      if (!st) st = fesd_set_state(it, 0, x0, NULL);
       fesd_integrate_info info;
-      memset(&info, 0, sizeof info);
-      if (!st) st = fesd_integrate(it, NULL, T_END, &info);
-      double x[2] = {NAN, NAN}, worst = 0;
-      const fesd_event *ev = NULL;
-      int nev = 0, order_ok = 1;
-      if (!st) {
-        fesd_get_state(it, NULL, x);
-        fesd_event_log(it, &ev, &nev);
-        order_ok = nev == nref;
-        for (int e = 0; e < nev && order_ok; e++) {
-          order_ok = (int)ev[e].kind == ev_k[e];
-          worst = fmax(worst, fabs(ev[e].t - ev_t[e]));
-        }
+      const int st = hd_integrate_set(&m, &set, rtols[r], rtols[r], 0, x0, T_END, &R, &info);
+      double worst = 0;
+      int order_ok = R.n_ev == nref;
+      for (int e = 0; e < R.n_ev && order_ok; e++) {
+        order_ok = (int)R.ev[e].kind == ev_k[e];
+        worst = fmax(worst, fabs(R.ev[e].t - ev_t[e]));
       }
-      const double err = hd_maxdiff(x, xT, 2);
+      const double err = hd_maxdiff(R.x_end, xT, 2);
       printf("Radau IIA s=%d rtol %.0e: %s, %d steps, %d rejected, %d failed attempts, %d Newton iterations, %d/%d events "
              "(worst time error %.1e), x(T) error %.1e\n",
-             s, rtols[r], fesd_status_name(st), info.steps, info.rejected, info.failed_attempts, info.newton_iter, nev, nref,
-             worst, err);
+             s, rtols[r], fesd_status_name(st), info.steps, info.rejected, info.failed_attempts, info.newton_iter, R.n_ev,
+             nref, worst, err);
       HD_CHECK(st == FESD_OK, "s=%d rtol %g: %s", s, rtols[r], fesd_status_name(st));
       HD_CHECK(order_ok && worst <= 10 * sqrt(rtols[r]), "s=%d rtol %g: %d/%d events, worst time error %.1e", s, rtols[r],
-               nev, nref, worst);
+               R.n_ev, nref, worst);
       HD_CHECK(err <= 100 * rtols[r], "s=%d rtol %g: x(T) error %.1e", s, rtols[r], err);
       HD_CHECK(info.newton_iter <= 10 * info.steps, "s=%d rtol %g: %d Newton iterations for %d steps", s, rtols[r],
                info.newton_iter, info.steps);
-      fesd_free(&it);
     }
   printf("%s (%d failures)\n", fails ? "FAILED" : "PASSED", fails);
   return fails ? 1 : 0;

@@ -212,45 +212,30 @@ int main(void) {
       {FESD_RK_RADAU_IIA, 2, "Radau IIA s=2"}, {FESD_RK_RADAU_IIA, 3, "Radau IIA s=3"},
       {FESD_RK_LOBATTO_IIIC, 3, "Lobatto IIIC s=3"}};
   printf("reference: entry %.15f, exit %.15f, x(3) = (%.15f, %.15f)\n", t_in, t_out, xT[0], xT[1]);
+  static hd_run R;
   for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
     fesd_settings set;
     fesd_settings_default(&set);
     set.family = cases[c].fam;
     set.stages = cases[c].s;
-    fesd_integrator *it = NULL;
-    int st = fesd_create(&it, &m, &set);
-    fesd_tolerances tol;
-    fesd_tolerances_default(&tol);
-    tol.rtol = 1e-11;
-    tol.atol = 1e-13;
     const double x0[2] = {0, 0.5};
-    if (!st) st = fesd_set_tolerances(it, &tol);
-    if (!st) st = fesd_set_state(it, 0, x0, NULL);
     fesd_integrate_info info;
-    if (!st) st = fesd_integrate(it, NULL, T, &info);
-    double x[2] = {NAN, NAN}, e_in = INFINITY, e_out = INFINITY;
-    const fesd_event *ev = NULL;
-    int nev = 0;
-    if (!st) {
-      fesd_get_state(it, NULL, x);
-      fesd_event_log(it, &ev, &nev);
-      for (int e = 0; e < nev; e++) {
-        if (ev[e].kind == FESD_EVENT_SLIDING_ENTRY) e_in = fmin(e_in, fabs(ev[e].t - t_in));
-        if (ev[e].kind == FESD_EVENT_SLIDING_EXIT) e_out = fmin(e_out, fabs(ev[e].t - t_out));
-      }
+    const int st = hd_integrate_set(&m, &set, 1e-11, 1e-13, 0, x0, T, &R, &info);
+    double e_in = INFINITY, e_out = INFINITY;
+    for (int e = 0; e < R.n_ev; e++) {
+      if (R.ev[e].kind == FESD_EVENT_SLIDING_ENTRY) e_in = fmin(e_in, fabs(R.ev[e].t - t_in));
+      if (R.ev[e].kind == FESD_EVENT_SLIDING_EXIT) e_out = fmin(e_out, fabs(R.ev[e].t - t_out));
     }
-    const double err = hd_maxdiff(x, xT, 2);
+    const double err = hd_maxdiff(R.x_end, xT, 2);
     printf("%-16s rtol 1e-11 atol 1e-13: %s, %d steps, %d rejected, %d Newton iterations, %d events, entry err %.1e, "
            "exit err %.1e, x(3) err %.1e\n",
-           cases[c].name, fesd_status_name(st), st ? 0 : info.steps, st ? 0 : info.rejected, st ? 0 : info.newton_iter, nev,
-           e_in, e_out, err);
+           cases[c].name, fesd_status_name(st), info.steps, info.rejected, info.newton_iter, R.n_ev, e_in, e_out, err);
     HD_CHECK(st == FESD_OK, "%s: %s", cases[c].name, fesd_status_name(st));
-    HD_CHECK(nev == 2 && e_in <= 1e-8 && e_out <= 1e-8, "%s: %d events, entry err %.1e, exit err %.1e", cases[c].name,
-             nev, e_in, e_out);
+    HD_CHECK(R.n_ev == 2 && e_in <= 1e-8 && e_out <= 1e-8, "%s: %d events, entry err %.1e, exit err %.1e", cases[c].name,
+             R.n_ev, e_in, e_out);
     HD_CHECK(err <= 1e-8, "%s: x(3) err %.1e", cases[c].name, err);
     HD_CHECK(!st && info.newton_iter < 3 * info.steps, "%s: %d Newton iterations for %d steps", cases[c].name,
-             st ? -1 : info.newton_iter, st ? 0 : info.steps);
-    fesd_free(&it);
+             info.newton_iter, info.steps);
   }
   fails += fixed_step_log(&m, t_in, t_out, phi_e);
   fails += coarse_flags();
