@@ -144,7 +144,9 @@ int main(void) {
   printf("  returned iterate: dynamics defect %.3e (reported feasibility %.3e)\n", dd, info.feasibility);
   CHECK(dd <= info.feasibility * (1 + 1e-6) + 1e-12 && dd >= 0.5 * info.feasibility, "defect %.3e vs feasibility %.3e",
         dd, info.feasibility);
-  CHECK(info.feasibility > 0 && info.feasibility < 1e-3, "feasibility %.3e", info.feasibility);
+  /* a stalled iterate, not a solution: 1e-4 to 1e-3 before the integrator checked Filippov's
+   * conditions at switch points (verify.c), 9.9e-3 after (another path of iterates) */
+  CHECK(info.feasibility > 0 && info.feasibility < 0.05, "feasibility %.3e", info.feasibility);
 
   /* plain Gauss-Newton: no fallback, stops after the first window */
   st = solve(&P, FESD_RK_RADAU_IIA, 1, FESD_OCP_HESSIAN_GAUSS_NEWTON, &info, x, u, &is);
