@@ -44,15 +44,34 @@ void fesd__normal_components(fesd_integrator *it, const fesd__point_eval *pe, co
 double fesd__cc_max(const fesd__system *S, const double *z);
 /* Earliest violation of the active sets act (N*s blocks) in z over all subsystems (v) and, when
  * per_sys is non-NULL, the earliest of each subsystem (nsys entries). strict (standard method):
- * every stage is checked. Collocation methods are also checked between the stage points (the
- * region of the collocation polynomial, and Filippov's conditions of 2-mode sliding modes).
- * Returns FESD_OK or a callback status. */
+ * every stage is checked. Implicit methods are also checked between the stage points (the
+ * region of the collocation polynomial or interpolant, and Filippov's conditions of 2-mode
+ * sliding modes) and at the switch points. Returns FESD_OK or a callback status. */
 int fesd__scan(fesd_integrator *it, const double *z, const unsigned char *act, int strict,
                fesd__violation *v, fesd__violation *per_sys);
 /* A converged FESD solution passes: h > 0, cross complementarity, and the scan of its own
  * active sets (theta > active_tol) finds nothing. FESD_ERR_STEP_FAILED otherwise. */
 int fesd__verify(fesd_integrator *it, const double *z, double *ccm);
-/* Collocation polynomial of element n of z at the weights w (fesd__colloc_weights). */
+/* Record violation c of a subsystem in v if it is earlier than the one held. */
+static inline void fesd__note_violation(fesd__violation *v, const fesd__violation *c) {
+  if (!v->found || c->t < v->t) *v = *c;
+}
+/* Filippov's conditions of the 2-mode sliding of subsystem k with modes i, j at an evaluated
+ * point (relative tolerance rel): the mode whose field clearly points into its own region, -1
+ * for both (repulsive), -2 for none (a sliding mode). */
+int fesd__filippov(fesd_integrator *it, const fesd__point_eval *pe, const double *th, const double *ftot, int i,
+                   int j, double rel);
+/* Whether a co-dimension-2 sliding mode has a consistent alternative for subsystem k. */
+int fesd__alternative_exists(fesd_integrator *it, const fesd__point_eval *pe, const unsigned char *a, int k, int i,
+                             int j);
+
+/* ---- verify_between.c ---- */
+/* Filippov's conditions at the element boundaries where a subsystem crosses or leaves a
+ * sliding mode (the new field must leave the surface), and between the stage points. */
+int fesd__scan_switch_points(fesd_integrator *it, const double *z, const unsigned char *act, fesd__violation *ps);
+int fesd__scan_interior(fesd_integrator *it, const double *z, const unsigned char *act, fesd__violation *ps);
+/* Interpolant of element n of z at the weights w (collocation polynomial, fesd__colloc_weights,
+ * or the interior-check weights of Lobatto IIIC). */
 void fesd__poly_state(const fesd_integrator *it, const double *z, int n, const double *w, double *x);
 /* State of z at time t from the step start (collocation polynomial, or piecewise linear
  * through the stage states for the other families). */

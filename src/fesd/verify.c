@@ -22,85 +22,10 @@
 /* Filippov check: normal components of the same sign whose smaller one exceeds this fraction
  * of the larger one at a stage point (a field clearly pointing away from the surface)... */
 #define FIL_STAGE_TOL 1e-4
-/* ...and at the midpoints between stage points, where the polynomial is an interpolant
- * (only a clear crossing counts there). */
-#define FIL_MID_TOL 0.1
-/* Interpolation allowance of the midpoint region check, in units of cc_tol. */
-#define INTERIOR_TOL 1e3
-/* Switch-point check: the entered field pointing back by more than this fraction of the two
- * normal components' sizes. */
-#define SWITCH_TOL 1e-2
 
 int fesd__collocation(const fesd_integrator *it) {
   const int f = it->tab.family;
   return f == FESD_RK_RADAU_IIA || f == FESD_RK_GAUSS_LEGENDRE || f == FESD_RK_LOBATTO_IIIA;
-}
-
-/* Lobatto IIIC has no collocation polynomial: its interior check uses the interpolant through
- * x_n and the stage states at c_j > 0 (its stage at c = 0 lies O(h^2) off x_n),
- * x(tau) = x_n + h sum_l (sum_j L_j(tau) A_jl) v_l. Measured before (randomised relay with a
- * ramp input, tests/hard/test_switch_point.c): s = 3 stepped over sliding phases of 0.05 to
- * 0.07 inside elements of 0.46 to 0.9 unflagged (21 of 4345 runs). */
-static void interp_weights(const fesd_tableau *T, double tau, double *w) {
-  for (int l = 0; l < T->s; l++) w[l] = 0;
-  for (int j = 0; j < T->s; j++) {
-    if (!(T->c[j] > 0)) continue;
-    double L = tau / T->c[j];
-    for (int m = 0; m < T->s; m++)
-      if (m != j && T->c[m] > 0) L *= (tau - T->c[m]) / (T->c[j] - T->c[m]);
-    for (int l = 0; l < T->s; l++) w[l] += L * T->A[j][l];
-  }
-}
-
-void fesd__interior_setup(fesd_integrator *it) {
-  const fesd_tableau *T = &it->tab;
-  if (T->is_explicit) { /* explicit stages are low-order predictions: no interior check */
-    it->n_mid = 0;
-    return;
-  }
-  double nodes[FESD_RK_MAX_STAGES + 2];
-  int nn = 0;
-  nodes[nn++] = 0.0;
-  for (int j = 0; j < T->s; j++)
-    if (T->c[j] > nodes[nn - 1]) nodes[nn++] = T->c[j];
-  if (nodes[nn - 1] < 1.0) nodes[nn++] = 1.0;
-  it->n_mid = nn - 1;
-  for (int p = 0; p + 1 < nn; p++) {
-    it->mid_tau[p] = 0.5 * (nodes[p] + nodes[p + 1]);
-    if (fesd__collocation(it)) fesd__colloc_weights(it, it->mid_tau[p], it->mid_w + p * FESD_RK_MAX_STAGES);
-    else interp_weights(T, it->mid_tau[p], it->mid_w + p * FESD_RK_MAX_STAGES);
-    int jn = 0;
-    for (int j = 1; j < T->s; j++)
-      if (fabs(T->c[j] - it->mid_tau[p]) < fabs(T->c[jn] - it->mid_tau[p])) jn = j;
-    it->mid_stage[p] = jn;
-  }
-}
-
-/* The states at count points of element n with weights w + q FESD_RK_MAX_STAGES, into
- * x + q nx (the interior check's midpoints of an element at once). */
-static void poly_states(const fesd_integrator *it, const double *z, int n, const double *w, int count, double *x) {
-  const fesd__system *S = &it->sys;
-  const int nx = S->nx, s = S->s, sb = S->sb;
-  const double *xn = n == 0 ? S->x0 : z + S->xo[n - 1], h = z[S->ho[n]], *ve = z + S->el[n];
-  for (int q = 0; q < count; q++, w += FESD_RK_MAX_STAGES, x += nx) {
-    if (nx <= s) { /* per component: x_n, then the stages in order (a short vector) */
-      for (int r = 0; r < nx; r++) {
-        double a = xn[r];
-        for (int j = 0; j < s; j++) a += h * w[j] * ve[j * sb + r];
-        x[r] = a;
-      }
-      continue;
-    }
-    memcpy(x, xn, (size_t)nx * sizeof(double)); /* the same sums, stage by stage over the vector */
-    for (int j = 0; j < s; j++) {
-      const double hw = h * w[j], *v = ve + j * sb;
-      for (int r = 0; r < nx; r++) x[r] += hw * v[r];
-    }
-  }
-}
-
-void fesd__poly_state(const fesd_integrator *it, const double *z, int n, const double *w, double *x) {
-  poly_states(it, z, n, w, 1, x);
 }
 
 void fesd__state_at(fesd_integrator *it, const double *z, int N, double t, double *x) {
@@ -147,10 +72,6 @@ void fesd__state_at(fesd_integrator *it, const double *z, int N, double t, doubl
   for (int r = 0; r < nx; r++) x[r] = xa[r] + f * (xb[r] - xa[r]);
 }
 
-/* Record a violation of subsystem k if it is earlier than the one held. */
-static void note(fesd__violation *v, const fesd__violation *c) {
-  if (!v->found || c->t < v->t) *v = *c;
-}
 
 /* Whether subsystem k's active set changes at the boundary starting element n (act per stage). */
 static int set_changes(const fesd_integrator *it, const unsigned char *act, int n, int k) {
@@ -234,7 +155,7 @@ static void scan_signs(fesd_integrator *it, const double *z, const unsigned char
            * after it: the entry should have been a crossing (a corner) */
           c.first = isnan(v0) || c.t <= t_change + t_eps || (kept && a && t0 <= t_change + t_eps);
           c.filippov = 0;
-          note(&ps[k], &c);
+          fesd__note_violation(&ps[k], &c);
           done = 1;
           break;
         }
@@ -282,7 +203,7 @@ void fesd__normal_components(fesd_integrator *it, const fesd__point_eval *pe, co
  * point: with psi = g_i - g_j (< 0 in region i) sliding needs d psi/dt >= 0 along mode i and
  * <= 0 along mode j. Returns the mode whose field clearly points into its own region (the one
  * that continues), -1 for both (repulsive), -2 for none. */
-static int filippov(fesd_integrator *it, const fesd__point_eval *pe, const double *th, const double *ftot,
+int fesd__filippov(fesd_integrator *it, const fesd__point_eval *pe, const double *th, const double *ftot,
                     int i, int j, double rel) {
   double ai, aj;
   fesd__normal_components(it, pe, th, ftot, i, j, &ai, &aj);
@@ -297,7 +218,7 @@ static int filippov(fesd_integrator *it, const fesd__point_eval *pe, const doubl
  * k's mode: the sliding mode stands if neither of k's modes, alone and with the other sliding
  * subsystems' multipliers solved again, is a consistent continuation (its field keeps it in
  * its region and the others still slide). Returns 1 if some alternative is consistent. */
-static int alternative_exists(fesd_integrator *it, const fesd__point_eval *pe, const unsigned char *a, int k, int i,
+int fesd__alternative_exists(fesd_integrator *it, const fesd__point_eval *pe, const unsigned char *a, int k, int i,
                               int j) {
   const fesd__model *m = &it->model;
   const int nth = m->nth, nx = m->nx;
@@ -324,7 +245,7 @@ static int alternative_exists(fesd_integrator *it, const fesd__point_eval *pe, c
     int ok = dp <= FIL_STAGE_TOL * (fabs(dp) + fabs(dq));
     for (int l = 0; l < m->nsys && ok; l++) {
       int jl, il = fesd__two_modes(&it->model, a2, l, &jl);
-      if (il >= 0) ok = filippov(it, pe, th2, f2, il, jl, FIL_STAGE_TOL) == -2;
+      if (il >= 0) ok = fesd__filippov(it, pe, th2, f2, il, jl, FIL_STAGE_TOL) == -2;
     }
     found = ok;
   }
@@ -368,11 +289,11 @@ static int scan_filippov(fesd_integrator *it, const double *z, const unsigned ch
           /* the element end where k's set changes is the switch point itself (a sliding exit:
            * the remaining field is tangent there) */
           if (S->tab.c[q] == 1.0 && n + 1 < S->N && set_changes(it, act, n + 1, k)) continue;
-          int c = filippov(it, &pe, th, it->ftot, i, j, FIL_STAGE_TOL);
-          if (c == -2 || !alternative_exists(it, &pe, a, k, i, j)) continue;
+          int c = fesd__filippov(it, &pe, th, it->ftot, i, j, FIL_STAGE_TOL);
+          if (c == -2 || !fesd__alternative_exists(it, &pe, a, k, i, j)) continue;
           fesd__violation v = {1, tn + S->tab.c[q] * h, c < 0 ? i : c, k, 0, n, n * s + q, 0, 1, 0, 0};
           v.filippov = c < 0 ? -1 : 1;
-          note(&ps[k], &v);
+          fesd__note_violation(&ps[k], &v);
         }
       }
     }
@@ -380,119 +301,6 @@ static int scan_filippov(fesd_integrator *it, const double *z, const unsigned ch
   }
   return FESD_OK;
 }
-
-/* Filippov's conditions at the switch points themselves: a crossing into mode j, or an exit
- * from a sliding mode onto j, needs j's field at the boundary state to leave the surface into
- * j's region (or run along it). The equations see the fields only at stage points; on a long
- * element whose only stage is its end (implicit Euler) both a crossing and an early exit stay
- * consistent there while the field at the switch points back (measured, ocp_step_eq, Radau
- * IIA s = 1, a start at the co-dimension-2 point: a crossing at t = 2 where the exact flow
- * slides to 2.4255, and an exit at 2.2835; the step map jumped between three solutions). Exits
- * are checked where they are pinned at a stage (c_s = 1): there the remaining field is tangent
- * up to round-off, while an extrapolated exit (Gauss-Legendre) is off by its order. */
-static int scan_switch_points(fesd_integrator *it, const double *z, const unsigned char *act, fesd__violation *ps) {
-  fesd__system *S = &it->sys;
-  fesd__model *m = &it->model;
-  const int nth = S->nth, s = S->s, exits = S->tab.c[s - 1] == 1.0;
-  fesd__point_eval pe;
-  double tb = 0;
-  for (int n = 1; n < S->N; n++) {
-    tb += z[S->ho[n - 1]];
-    const unsigned char *P = act + (size_t)(n * s - 1) * nth, *Q = act + (size_t)(n * s) * nth;
-    int same = 1; /* a byte loop: this runs on every ordinary step, a memcmp call cost more */
-    for (int l = 0; l < nth && same; l++) same = P[l] == Q[l];
-    if (same) continue;
-    int evaluated = 0;
-    for (int k = 0; k < m->nsys; k++) {
-      int i = -1, j = -1, np = 0, nq = 0, shared = 0;
-      for (int l = m->th_off[k]; l < m->th_off[k + 1]; l++) {
-        np += P[l], nq += Q[l], shared += P[l] && Q[l];
-        if (Q[l] && !P[l]) j = l;
-        if (P[l] && !Q[l]) i = l;
-      }
-      if (np == shared && nq == shared) continue; /* k's set unchanged */
-      if (nq != 1) continue;                      /* entries into sliding modes: scan_filippov */
-      if (np == 1 && shared == 0) { /* a crossing i -> j */
-      } else if (np == 2 && shared == 1 && exits) { /* an exit: i leaves, j stays */
-        for (int l = m->th_off[k]; l < m->th_off[k + 1]; l++)
-          if (Q[l]) j = l;
-      } else {
-        continue;
-      }
-      if (i < 0 || j < 0) continue;
-      const double *th = z + fesd__th(S, n, 0);
-      if (!evaluated) {
-        pe = fesd__scratch_eval(it);
-        int st = fesd__model_eval(m, S->t0 + tb, z + S->xo[n - 1], S->u, &pe);
-        if (st) return st;
-        fesd__total_field(it, &pe, th, it->ftot);
-        evaluated = 1;
-      }
-      double ai, aj; /* psi = g_i - g_j < 0 in region i: j leaves into its region when aj > 0 */
-      fesd__normal_components(it, &pe, th, it->ftot, i, j, &ai, &aj);
-      if (!(aj < -SWITCH_TOL * (fabs(ai) + fabs(aj)))) continue;
-      /* the switch chose wrong: a crossing slides (j wants out), an exit is early (i wants in) */
-      fesd__violation v = {1, tb, np == 1 ? j : i, k, np == 1 ? 0 : 1, n, n * s, 1, 0, tb, tb};
-      note(&ps[k], &v);
-    }
-  }
-  return FESD_OK;
-}
-
-/* Between the stage points (implicit methods): the region of the polynomial, and
- * Filippov's conditions of 2-mode sliding modes (with theta of the nearest stage). */
-static int scan_interior(fesd_integrator *it, const double *z, const unsigned char *act, fesd__violation *ps) {
-  fesd__system *S = &it->sys;
-  fesd__model *m = &it->model;
-  const int s = S->s, nth = S->nth;
-  double *xm = it->gbuf + nth; /* the midpoint states of an element */
-  fesd__point_eval pe = fesd__scratch_eval(it);
-  double tn = 0;
-  for (int n = 0; n < S->N; n++) {
-    const double h = z[S->ho[n]];
-    const unsigned char *a = act + (size_t)(n * s) * nth;
-    int sliding = 0;
-    for (int k = 0; k < m->nsys && !sliding; k++) {
-      int j;
-      sliding = fesd__two_modes(&it->model, a, k, &j) >= 0;
-    }
-    poly_states(it, z, n, it->mid_w, it->n_mid, xm);
-    for (int p = 0; p < it->n_mid; p++) {
-      const double *x = xm + (size_t)p * S->nx;
-      fesd__point_eval q = pe;
-      if (!sliding) q.F = q.dgdx = NULL;
-      const double t = tn + it->mid_tau[p] * h;
-      int st = fesd__model_eval(m, S->t0 + t, x, S->u, &q);
-      if (st) return st;
-      const double *th = z + fesd__th(S, n, it->mid_stage[p]); /* the nearest stage's */
-      if (sliding) fesd__total_field(it, &q, th, it->ftot);
-      for (int k = 0; k < m->nsys; k++) {
-        double gact = INFINITY, gin = INFINITY;
-        int lin = -1;
-        for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) {
-          if (a[i]) gact = pe.g[i] < gact ? pe.g[i] : gact;
-          else if (pe.g[i] < gin) gin = pe.g[i], lin = i;
-        }
-        if (lin >= 0 && (gin - gact) * S->wG[k] < -INTERIOR_TOL * it->set.cc_tol) {
-          fesd__violation v = {1, t, lin, k, 1, n, n * s + s, 0, 0, tn, t};
-          note(&ps[k], &v);
-          continue;
-        }
-        if (!sliding) continue;
-        int j, i = fesd__two_modes(&it->model, a, k, &j);
-        if (i < 0) continue;
-        int c = filippov(it, &q, th, it->ftot, i, j, FIL_MID_TOL);
-        if (c == -2 || !alternative_exists(it, &q, a, k, i, j)) continue;
-        fesd__violation v = {1, t, c < 0 ? i : c, k, 0, n, n * s + s, 0, c < 0 ? -1 : 1, 0, 0};
-        note(&ps[k], &v);
-      }
-    }
-    tn += h;
-  }
-  return FESD_OK;
-}
-
-static int S_explicit(const fesd_integrator *it) { return it->sys.tab.is_explicit; }
 
 int fesd__scan(fesd_integrator *it, const double *z, const unsigned char *act, int strict,
                fesd__violation *v, fesd__violation *per_sys) {
@@ -503,12 +311,12 @@ int fesd__scan(fesd_integrator *it, const double *z, const unsigned char *act, i
   int st = FESD_OK;
   if (!strict && it->set.method == FESD_METHOD_FESD) {
     st = scan_filippov(it, z, act, ps);
-    if (!st && !S_explicit(it)) st = scan_switch_points(it, z, act, ps);
-    if (!st && it->n_mid > 0) st = scan_interior(it, z, act, ps);
+    if (!st && !it->sys.tab.is_explicit) st = fesd__scan_switch_points(it, z, act, ps);
+    if (!st && it->n_mid > 0) st = fesd__scan_interior(it, z, act, ps);
   }
   memset(v, 0, sizeof(*v));
   for (int k = 0; k < K; k++)
-    if (ps[k].found) note(v, &ps[k]);
+    if (ps[k].found) fesd__note_violation(v, &ps[k]);
   return st;
 }
 
