@@ -10,6 +10,7 @@
  * estimate). The estimate is the
  * weighted RMS norm of x^ - x with weights 1 / (atol_r + rtol max(|x_n,r|, |x_n+1,r|)),
  * maximised over the elements (explicit RK: no estimate). */
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -130,7 +131,9 @@ int fesd__error_estimate(fesd_integrator *it, const double *z, double rtol, cons
  * families (v of the last stage is f at the element end; the element before gives f(x_n)) in
  * elements whose active set is the one before them: decaying and rotating modes give q <= 0 */
 #define GROWTH_MAX 2.0
-static int outgrown(const fesd_integrator *it) {
+static int outgrown(const fesd_integrator *it, double big) {
+  /* increments at round-off (a mass stuck at rest moves by 1e-30) show no growth */
+  const double dd_min = (64 * DBL_EPSILON * big) * (64 * DBL_EPSILON * big);
   const fesd__system *S = &it->sys;
   if (!S->tab.stiffly_accurate || !S->tab.c_end_is_one) return 0;
   const int s = S->s, nth = S->nth, nx = S->nx;
@@ -143,7 +146,7 @@ static int outgrown(const fesd_integrator *it) {
       dd += d * d;
       dg += d * (fb[r] - fa[r]);
     }
-    if (!(z[S->ho[n]] * dg > GROWTH_MAX * dd)) continue;
+    if (!(dd > dd_min) || !(z[S->ho[n]] * dg > GROWTH_MAX * dd)) continue;
     /* rare: the quotient means growth only where both element ends have one active set */
     const unsigned char *a0 = it->act + (size_t)(n * s - 1) * nth, *a1 = a0 + (size_t)s * nth;
     if (!memcmp(a0, a1, (size_t)nth)) return 1;
@@ -161,13 +164,17 @@ int fesd__coarse_check(fesd_integrator *it, fesd_step_info *info) {
   for (int r = 0; r < it->nx; r++) {
     sz[r] = fesd__fmax(S->refX[r], fabs(it->x[r]));
     for (int n = 0; n < S->N; n++) sz[r] = fesd__fmax(sz[r], fabs(it->z[S->xo[n] + r]));
-    big = fesd__fmax(big, sz[r]);
+    big = fesd__fmax(big, fesd__fmax(sz[r], S->motX[r]));
   }
-  for (int r = 0; r < it->nx; r++) sz[r] = it->set.coarse_tol * fesd__fmax(sz[r], 1e-6 * big) + 1e-300;
+  /* a component at rest (all its values 0: a stuck mass) is measured against the motion its
+   * fields could make in the step (motX, weights.c) or 1e-6 of the largest size or motion of
+   * any component; against its own round-off (1e-30) every stuck step was flagged coarse */
+  for (int r = 0; r < it->nx; r++)
+    sz[r] = it->set.coarse_tol * fesd__fmax(fesd__fmax(sz[r], 1e-6 * big), 1e-3 * S->motX[r]) + 1e-300;
   double err;
   int st = fesd__error_estimate(it, it->z, 0.0, sz, &err);
   if (st) return st;
   info->error_estimate = fesd__fmax(info->error_estimate, err * it->set.coarse_tol);
-  if (!(err <= 1.0) || outgrown(it)) it->step_flags |= FESD_FLAG_COARSE;
+  if (!(err <= 1.0) || outgrown(it, big)) it->step_flags |= FESD_FLAG_COARSE;
   return FESD_OK;
 }

@@ -253,6 +253,7 @@ static void lay_out(fesd__system *S, int sens, fesd__block *B) {
   S->magX = fesd__block_take(B, ((size_t)nx) * sizeof(double), 1);
   S->magV = fesd__block_take(B, ((size_t)nx) * sizeof(double), 1);
   S->refX = fesd__block_take(B, ((size_t)nx) * sizeof(double), 1);
+  S->motX = fesd__block_take(B, ((size_t)nx) * sizeof(double), 1);
   S->refV = fesd__block_take(B, ((size_t)nx) * sizeof(double), 1);
   S->magG = fesd__block_take(B, ((size_t)nsys) * sizeof(double), 1);
   S->refG = fesd__block_take(B, ((size_t)nsys) * sizeof(double), 1);

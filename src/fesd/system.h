@@ -91,6 +91,9 @@ typedef struct {
   /* sizes at the last weighting (per state component: X rows, V rows; per subsystem: the
    * indicators), and their maxima over the accepted steps (weights.c) */
   double *magX, *magV, *magG, *refX, *refV, *refG;
+  /* per state component: max(refX, T max_i |f_i|) at the last weighting, the motion a step
+   * could make (the size of a component at rest on a surface, whose own values are 0) */
+  double *motX;
   int status;   /* last model status */
   /* Inputs of the last fesd__system_points (z, x0, u, t0, want_u; pc_jac: with Jacobians):
    * the weights and the solver's first residual evaluate the same z, and a Newton step's

@@ -21,6 +21,7 @@
  * make: |f_i,r| for x'_r, T |f_i,r| for x_r, sum_c |dg/dx_c| T |f_i,c| for the indicators.
  * The solver keeps the weights of one solve fixed; the caller recomputes them at the solution
  * and checks again (step.c). */
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -139,9 +140,19 @@ int fesd__system_weights(fesd__system *S, const double *z) {
   }
   /* invert, with the floors of each component, subsystem and mode */
   double *restrict fX = xi, *restrict fV = acc, *restrict fth = S->tmp + 4 * nx + nth; /* scratch reused */
+  /* A component whose fields vanish in every mode at every point (a cost state x_q' = x_s^2 while
+   * x_s slides at rest on x_s = 0: all its terms are round-off) has no size at all; it gets eps
+   * times the largest size of any component, or round-off is weighted up to 1e300 and no weight
+   * pass settles (measured: FESD_ERR_STEP_FAILED on every such step, 331 Newton iterations). */
+  double gX = 0, gV = 0;
   for (int r = 0; r < nx; r++) {
-    fX[r] = amax(ATOL_REL * amax(S->refX[r], T * mf[r]), FLOOR);
-    fV[r] = amax(ATOL_REL * amax(S->refV[r], mf[r]), FLOOR);
+    gX = amax(gX, amax(S->refX[r], T * mf[r]));
+    gV = amax(gV, amax(S->refV[r], mf[r]));
+  }
+  for (int r = 0; r < nx; r++) {
+    S->motX[r] = amax(S->refX[r], T * mf[r]);
+    fX[r] = amax(amax(ATOL_REL * S->motX[r], DBL_EPSILON * gX), FLOOR);
+    fV[r] = amax(amax(ATOL_REL * amax(S->refV[r], mf[r]), DBL_EPSILON * gV), FLOOR);
   }
   for (int k = 0; k < nsys; k++) {
     const double fG = amax(ATOL_REL * amax(S->refG[k], gf[k]), FLOOR);
