@@ -6,7 +6,12 @@
  *  2. ocp_step_eq with the terminal condition q(4) = q_final as a hard constraint and |v| <= 0.5:
  *     the field -sign(c) + v, |v| < 1, keeps q on the attracting surfaces and the target is out of
  *     reach (nonlinear infeasibility: the linearisations are inconsistent at every iterate).
- * And the feasible counterpart of 2 (|v| <= 2) converges to the L1 version's solution. */
+ * And the feasible counterpart of 2 (|v| <= 2) converges to the L1 version's solution.
+ *  3. a mass at rest under Coulomb friction, x' = v, v' = u - mu sign(v), mu = 1, |u| <= 0.8, asked
+ *     to reach x(2) = 1: it never moves (closed form), so the least violation is 1, at every
+ *     control. Before the SQP sent an inconsistent linearisation to the elastic QP when the
+ *     regularised QP "solved" it without reducing the violation, this ran 200 iterations (and the
+ *     presolve 200) to FESD_ERR_ITER_LIMIT, its steps 1e-16 and the penalty at 1e11. */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -36,6 +41,20 @@ static int ident2(double t, const double *x, const double *u, double *e, double 
   if (ex) ex[0] = 1, ex[1] = 0, ex[2] = 0, ex[3] = 1;
   return 0;
 }
+static int fr_field(int sys, int mode, double t, const double *x, const double *u, double *f, void *user) {
+  f[0] = x[1], f[1] = u[0] - (mode == 0 ? 1.0 : -1.0);
+  return 0;
+}
+static int fr_sw(int sys, double t, const double *x, const double *u, double *c, void *user) {
+  c[0] = x[1];
+  return 0;
+}
+static int pos1(double t, const double *x, const double *u, double *e, double *ex, double *eu, void *user) {
+  e[0] = x[0] - 1;
+  if (ex) ex[0] = 1, ex[1] = 0;
+  return 0;
+}
+
 static int q_target(double t, const double *x, const double *u, double *e, double *ex, double *eu, void *user) {
   const double *qf = fesd_ocp_step_eq_target();
   e[0] = x[0] - qf[0], e[1] = x[1] - qf[1];
@@ -108,6 +127,32 @@ int main(void) {
       CHECK(st == FESD_ERR_INFEASIBLE, "2 (|v| <= 0.5): %s", fesd_status_name(st));
       CHECK(info.feasibility > 0.1, "2: violation %.3e", info.feasibility);
     }
+    fesd_ocp_free(&o);
+  }
+  /* 3. a mass stuck by friction */
+  {
+    fesd_model fr = {.nx = 2, .nu = 1, .nsys = 1, .n_modes = n_modes, .n_switch = n_switch, .field = fr_field,
+                     .sw = fr_sw};
+    const double ul3[1] = {-0.8}, uu3[1] = {0.8}, zero[1] = {0};
+    fesd_ocp_problem p3 = {.model = &fr, .n_ctrl = 10, .t0 = 0, .tf = 2, .x0 = x0, .u_lb = ul3, .u_ub = uu3,
+                           .n_lagrange_lsq = 1, .lagrange_lsq = di_lsq, .n_term = 1, .terminal = pos1,
+                           .term_lb = zero, .term_ub = zero};
+    fesd_ocp_settings_default(&s);
+    CHECK(fesd_ocp_create(&o, &p3, &s) == FESD_OK, "create 3");
+    double ug3[10];
+    for (int k = 0; k < 10; k++) ug3[k] = 0.8;
+    fesd_ocp_set_guess(o, NULL, ug3);
+    st = fesd_ocp_solve(o, &info);
+    double x3[22];
+    fesd_ocp_get_solution(o, x3, NULL);
+    printf("stuck mass, |u| <= 0.8 < mu: %s after %d iterations (presolve %d), x(2) = %.2e, violation %.6f "
+           "(least: 1)\n",
+           fesd_status_name(st), info.iterations, info.presolve_iterations, x3[20], info.feasibility);
+    CHECK(st == FESD_ERR_INFEASIBLE, "3: %s", fesd_status_name(st));
+    CHECK(info.iterations + info.presolve_iterations <= 10, "3: %d + %d iterations", info.iterations,
+          info.presolve_iterations);
+    CHECK(fabs(x3[20]) <= 1e-12 && fabs(info.feasibility - 1) <= 1e-9, "3: x(2) %.3e, violation %.9f", x3[20],
+          info.feasibility);
     fesd_ocp_free(&o);
   }
   if (fails) printf("%d check(s) failed\n", fails);

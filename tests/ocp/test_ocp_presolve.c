@@ -8,6 +8,9 @@
  *    same objective as without it;
  *  - a presolve whose point the requested discretisation cannot evaluate falls back to the guess
  *    (then the solve is the one without presolve);
+ *  - a presolve whose point the SQP cannot solve from (a relay oscillator, v' = -20 sign(x) + u,
+ *    3 crossings per interval: LINE_SEARCH at iteration 0 from it, where the guess converges):
+ *    the solve is repeated from the guess and matches the solve without presolve;
  *  - the settings' ranges;
  *  - the model's callbacks never see a non-finite t, x or u (the semismooth Newton's line
  *    search used to evaluate trial points of a direction with NaN entries: t = NaN in the
@@ -73,6 +76,45 @@ static int solve(fesd_ocp *o, const double *x0, double *u, fesd_ocp_info *info) 
   int st = fesd_ocp_solve(o, info);
   fesd_ocp_get_solution(o, NULL, u);
   return st;
+}
+
+/* relay oscillator x' = v, v' = -20 sign(x) + u, min int u^2 + 1e3 |(x, v)(T)|^2 */
+static int osc_field(int sys, int mode, double t, const double *x, const double *u, double *f, void *user) {
+  (void)sys, (void)t, (void)user;
+  f[0] = x[1], f[1] = -20.0 * (mode == 0 ? 1.0 : -1.0) + u[0];
+  return 0;
+}
+static int osc_jac(int sys, int mode, double t, const double *x, const double *u, double *J, double *Ju,
+                   void *user) {
+  (void)sys, (void)mode, (void)t, (void)x, (void)u, (void)user;
+  J[0] = 0, J[1] = 0, J[2] = 1, J[3] = 0; /* column-major */
+  if (Ju) Ju[0] = 0, Ju[1] = 1;
+  return 0;
+}
+static int osc_sw_jac(int sys, double t, const double *x, const double *u, double *J, double *Ju, void *user) {
+  (void)sys, (void)t, (void)x, (void)u, (void)user;
+  J[0] = 1, J[1] = 0;
+  if (Ju) Ju[0] = 0;
+  return 0;
+}
+static int osc_sw(int sys, double t, const double *x, const double *u, double *c, void *user) {
+  (void)sys, (void)t, (void)u, (void)user;
+  c[0] = x[0];
+  return 0;
+}
+static int osc_lsq(double t, const double *x, const double *u, double *r, double *rx, double *ru, void *user) {
+  (void)t, (void)x, (void)user;
+  r[0] = u[0];
+  if (rx) rx[0] = rx[1] = 0;
+  if (ru) ru[0] = 1;
+  return 0;
+}
+static int osc_mayer(double t, const double *x, const double *u, double *r, double *rx, double *ru, void *user) {
+  (void)t, (void)u, (void)ru, (void)user;
+  const double w = sqrt(1e3);
+  r[0] = w * x[0], r[1] = w * x[1];
+  if (rx) rx[0] = w, rx[1] = 0, rx[2] = 0, rx[3] = w;
+  return 0;
 }
 
 int main(void) {
@@ -156,6 +198,36 @@ int main(void) {
           i1.objective, fesd_status_name(s0), i0.iterations, i0.objective);
   fesd_ocp_free(&a);
   fesd_ocp_free(&b);
+
+  /* a presolve point the SQP cannot solve from */
+  {
+    const int nm[1] = {2}, nsw[1] = {1};
+    fesd_model om = {.nx = 2, .nu = 1, .nsys = 1, .n_modes = nm, .n_switch = nsw, .field = osc_field,
+                     .field_jac = osc_jac, .sw = osc_sw, .sw_jac = osc_sw_jac};
+    const double ox0[2] = {1, 0}, oul[1] = {-50}, ouu[1] = {50};
+    fesd_ocp_problem oop = {.model = &om, .n_ctrl = 8, .t0 = 0, .tf = 4, .x0 = ox0, .u_lb = oul, .u_ub = ouu,
+                            .n_lagrange_lsq = 1, .lagrange_lsq = osc_lsq, .n_mayer_lsq = 2, .mayer_lsq = osc_mayer};
+    fesd_ocp_info oi[2];
+    int os[2];
+    for (int pre = 0; pre < 2; pre++) {
+      fesd_ocp_settings oset;
+      fesd_ocp_settings_default(&oset);
+      oset.presolve = pre;
+      fesd_ocp *oo;
+      CHECK(fesd_ocp_create(&oo, &oop, &oset) == FESD_OK, "create oscillator");
+      os[pre] = fesd_ocp_solve(oo, &oi[pre]);
+      fesd_ocp_free(&oo);
+    }
+    printf("relay oscillator: presolve run %d used %d: %s, %d it, f %.10f; without: %s, %d it, f %.10f\n",
+           oi[1].presolve_run, oi[1].presolve_used, fesd_status_name(os[1]), oi[1].iterations, oi[1].objective,
+           fesd_status_name(os[0]), oi[0].iterations, oi[0].objective);
+    CHECK(os[0] == FESD_OK && os[1] == FESD_OK, "oscillator: %s / %s", fesd_status_name(os[0]),
+          fesd_status_name(os[1]));
+    CHECK(oi[1].presolve_run == 1 && oi[1].presolve_used == 0, "oscillator: presolve run %d used %d",
+          oi[1].presolve_run, oi[1].presolve_used);
+    CHECK(fabs(oi[1].objective - oi[0].objective) <= 1e-8 * oi[0].objective, "oscillator: f %.12f vs %.12f",
+          oi[1].objective, oi[0].objective);
+  }
 
   /* ranges */
   fesd_ocp_settings set;
