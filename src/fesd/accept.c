@@ -199,6 +199,15 @@ static int active_modes(const fesd_integrator *it, const double *th, int k, int 
   return c;
 }
 
+/* ... from flags (an active set) */
+static int flagged_modes(const fesd_integrator *it, const unsigned char *a, int k, int *out) {
+  const fesd__model *m = &it->model;
+  int c = 0;
+  for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++)
+    if (a[i]) out[c++] = i - m->th_off[k];
+  return c;
+}
+
 /* ... and element n of z (active at any stage). */
 static int element_modes(const fesd_integrator *it, const double *z, int n, int k, int *out) {
   const fesd__model *m = &it->model;
@@ -388,8 +397,12 @@ int fesd__accept(fesd_integrator *it, const double *z, const double *u, double T
     /* events at the left boundary of element n */
     for (int k = 0; k < nsys; k++) {
       int *b = event_room(it);
-      if (n == 0 && !it->have_prev_theta) continue;
-      int nb = n == 0 ? active_modes(it, it->theta_prev, k, b) : element_modes(it, z, n - 1, k, b);
+      /* the first step after fesd_set_state: against the start's classification, so that a
+       * switch the plan moved to the start (an entry 1e-9 T after it) is logged as in any
+       * later step */
+      int nb = n > 0 ? element_modes(it, z, n - 1, k, b)
+               : it->have_prev_theta ? active_modes(it, it->theta_prev, k, b)
+                                     : flagged_modes(it, it->start_jumped ? it->act_first : it->act0, k, b);
       add_event(it, t, k, b, nb, element_modes(it, z, n, k, b + nb));
     }
     t += z[S->ho[n]];

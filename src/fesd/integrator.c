@@ -188,6 +188,7 @@ static void lay_out(fesd_integrator *it, const fesd_settings *settings, fesd__bl
   it->sw_at = fesd__block_take(B, (N + 1) * sizeof(int), 0);
   it->act = fesd__block_take(B, N * s * nth, 0); /* per stage */
   it->act0 = fesd__block_take(B, nth, 0);
+  it->act_first = fesd__block_take(B, nth, 0);
   it->cand = fesd__block_take(B, nth, 0);
   it->swap_set = fesd__block_take(B, nth, 0);
   it->bmode = fesd__block_take(B, (N + 1) * sizeof(int), 1);

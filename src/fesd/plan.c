@@ -262,6 +262,10 @@ static int can_pin_exit(const fesd_integrator *it) { return it->set.exit_rows &&
  * is applied explicitly, accept.c). */
 static void start_jump(fesd_integrator *it, int k, const unsigned char *newset) {
   const fesd__model *m = &it->model;
+  if (!it->start_jumped) { /* the start's classification, for the first step's events (accept.c) */
+    memcpy(it->act_first, it->act0, (size_t)it->nth);
+    it->start_jumped = 1;
+  }
   int in = -1, out = -1;
   for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) {
     if (newset[i] && !it->act0[i] && in < 0) in = i;

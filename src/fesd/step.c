@@ -386,6 +386,7 @@ static int try_step(fesd_integrator *it, const double *u, double *T, fesd_step_i
   if ((st = set_h_bounds(it, *T, 0))) return st;
   int nonunique = 0;
   if ((st = fesd__act_start(it, u, it->act0, &nonunique))) return st;
+  it->start_jumped = 0;
   it->nonunique = nonunique;
   st = it->set.method == FESD_METHOD_FESD ? plan_path(it, T, info) : fesd__std_path(it, info);
   if (fesd__hard_failure(st)) return st;

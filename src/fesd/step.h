@@ -69,6 +69,8 @@ int fesd__alternative_exists(fesd_integrator *it, const fesd__point_eval *pe, co
 /* Filippov's conditions at the element boundaries where a subsystem crosses or leaves a
  * sliding mode (the new field must leave the surface), and between the stage points. */
 int fesd__scan_switch_points(fesd_integrator *it, const double *z, const unsigned char *act, fesd__violation *ps);
+/* A start within round-off of a surface that its field reaches at once: an entry at that time. */
+int fesd__scan_start(fesd_integrator *it, const double *z, const unsigned char *act, fesd__violation *ps);
 int fesd__scan_interior(fesd_integrator *it, const double *z, const unsigned char *act, fesd__violation *ps);
 /* Interpolant of element n of z at the weights w (collocation polynomial, fesd__colloc_weights,
  * or the interior-check weights of Lobatto IIIC). */

@@ -312,6 +312,7 @@ int fesd__scan(fesd_integrator *it, const double *z, const unsigned char *act, i
   if (!strict && it->set.method == FESD_METHOD_FESD) {
     st = scan_filippov(it, z, act, ps);
     if (!st && !it->sys.tab.is_explicit) st = fesd__scan_switch_points(it, z, act, ps);
+    if (!st && !it->sys.tab.is_explicit) st = fesd__scan_start(it, z, act, ps);
     if (!st && it->n_mid > 0) st = fesd__scan_interior(it, z, act, ps);
   }
   memset(v, 0, sizeof(*v));

@@ -173,6 +173,46 @@ int main(void) {
   printf("%d cases (%d near a tie skipped): %d FESD_OK (%d with a flagged step), %d failed with a status; of the "
          "OK: %d other event sequences than the flow's (%d unflagged), %d unflagged states beyond the bound\n",
          cases, skipped, ok, flagged_ok, failed, wrong_events, unflagged, wrong_state);
+  /* Starts within round-off of the surface on the side whose field points at it (x0 = -d,
+   * v0 in (-1, 0), a < 0: x reaches 0 after d / (1 + v0), slides until v = -1, leaves below):
+   * the same events and end state as a start d above (whose field also points at the surface).
+   * Before the start check (verify_between.c) implicit Euler stayed below on one element: end
+   * states 0.3 apart for d = 1e-9. */
+  int starts = 0, start_bad = 0, start_s1 = 0;
+  for (int c = 0; c < 40; c++) {
+    ramp P2 = {urand(&seed, -2.5, -0.8)};
+    const double v0 = urand(&seed, -0.8, -0.2), d = pow(10.0, urand(&seed, -12, -8)), T = 1.0;
+    fesd_model m = {.nx = 2, .nsys = 1, .n_modes = nm, .n_switch = ns, .field = f_ramp, .sw = c_ramp, .user = &P2};
+    for (int q = 0; q < nmeth; q++) {
+      fesd_settings set;
+      fesd_settings_default(&set);
+      set.family = meth[q].fam;
+      set.stages = meth[q].s;
+      double xe[2][2];
+      int ev[2], st[2];
+      for (int side = 0; side < 2; side++) {
+        const double x0[2] = {side ? d : -d, v0};
+        st[side] = hd_integrate(&m, &set, 0, x0, NULL, T, 1, &R);
+        ev[side] = R.n_ev;
+        memcpy(xe[side], R.x_end, sizeof xe[side]);
+      }
+      starts++;
+      const int bad = st[0] || st[1] || fabs(xe[0][0] - xe[1][0]) > 1e-6 * (1 + fabs(xe[1][0])) || ev[0] != ev[1];
+      if (meth[q].s == 1) { /* implicit Euler: several discrete solutions O(h) apart (counted) */
+        start_s1 += bad;
+        continue;
+      }
+      if (bad && start_bad++ < 6)
+        printf("  start %d %s s=%d: d %.1e v0 %.3f a %.3f: below %s %d events x(T) %.6f, above %s %d events x(T) "
+               "%.6f\n",
+               c, meth[q].fam == FESD_RK_RADAU_IIA ? "radau" : "lobatto3c", meth[q].s, d, v0, P2.a,
+               fesd_status_name(st[0]), ev[0], xe[0][0], fesd_status_name(st[1]), ev[1], xe[1][0]);
+    }
+  }
+  printf("starts within 1e-12..1e-8 of the surface, both sides, one step of 1: %d pairs, %d differ (s >= 2; "
+         "Radau s = 1: %d of 40)\n",
+         starts, start_bad, start_s1);
+  HD_CHECK(start_bad == 0, "%d of %d start pairs differ", start_bad, starts);
   HD_CHECK(cases >= 2000, "only %d cases", cases);
   HD_CHECK(unflagged == 0, "%d unflagged FESD_OK runs with another event sequence than the flow's", unflagged);
   HD_CHECK(wrong_state == 0, "%d FESD_OK runs with x(T) beyond the bound", wrong_state);
