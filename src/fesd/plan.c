@@ -18,6 +18,9 @@
 
 /* Active sets tried after one switch before the plan gives up on it. */
 #define MAX_TRIES 4
+/* Modes within this distance of the least indicator (units of the indicator scale) at a predicted
+ * switch count as tied there (a corner reached at the predicted time, to its accuracy). */
+#define CORNER_TIE 1e-6
 /* A switch predicted this close to the step start (fraction of T) happens at the start. */
 #define AT_START 1e-9
 /* ... and one predicted this close (not farther than the prediction error of an entry just
@@ -220,16 +223,53 @@ static int eval_on_path(fesd_integrator *it, const double *z, double t, fesd__po
   return fesd__model_eval(&it->model, S->t0 + t, x, S->u, pe);
 }
 
+/* A mode j entering next to a sliding mode P of a subsystem with more modes (a corner of one
+ * subsystem: an AND of two thresholds in a gene network) can end the sliding mode at once: the
+ * state leaves through the corner into a region of its own. The mode of P and j that alone
+ * keeps itself the strict minimum of g (d/dt (g_c - g_l) > 0 along the field with l alone, for
+ * every other candidate c), when exactly one does; else -1 (a sliding mode with j). Measured:
+ * x2 sliding on 0.7 under [x1 > 0.35][x2 < 0.7] while x1 falls through 0.35: the plan grew the
+ * sliding mode to 3 modes, cycled and failed (FESD_ERR_STEP_FAILED in 27 of 48 runs, every
+ * family; a 5-gene network could not be integrated past its first sliding exit). */
+static int consistent_alone(fesd_integrator *it, const fesd__point_eval *pe, const double *th, int k,
+                            const unsigned char *P, int j) {
+  const fesd__model *m = &it->model;
+  const int nx = m->nx;
+  double *f = it->ftot + nx; /* ftot: the total field at the point (the caller's) */
+  unsigned char *cand = it->swap_set;
+  double gmin = INFINITY;
+  for (int l = m->th_off[k]; l < m->th_off[k + 1]; l++) gmin = fmin(gmin, pe->g[l]);
+  /* candidates: P, j, and the modes tied with them at the point (the far side of the corner) */
+  for (int l = m->th_off[k]; l < m->th_off[k + 1]; l++)
+    cand[l] = P[l] || l == j || (pe->g[l] - gmin) * it->sys.wth[l] <= CORNER_TIE;
+  int pick = -1, n_ok = 0;
+  for (int l = m->th_off[k]; l < m->th_off[k + 1]; l++) {
+    if (!cand[l]) continue;
+    memcpy(f, it->ftot, (size_t)nx * sizeof(double));
+    for (int q = m->th_off[k]; q < m->th_off[k + 1]; q++)
+      if (th[q] != 0.0) fesd__F_axpy(m, pe, q, -th[q], f);
+    fesd__F_axpy(m, pe, l, 1.0, f);
+    int ok = 1;
+    for (int c = m->th_off[k]; c < m->th_off[k + 1] && ok; c++) {
+      if (c == l || !cand[c]) continue;
+      ok = fesd__dg_dot(m, pe, c, f) - fesd__dg_dot(m, pe, l, f) > 0;
+    }
+    if (ok) pick = l, n_ok++;
+  }
+  return n_ok == 1 ? pick : -1;
+}
+
 /* Entering mode j next to the set P of subsystem k at time t of the solution z: a crossing
- * (j alone) when j's field points into j's region, else a sliding mode (P and j). */
+ * (j alone) when j's field points into j's region, else a sliding mode (P and j); next to a
+ * sliding mode, the one candidate that is consistent alone (above) when there is one. */
 static int enter_set(fesd_integrator *it, const double *z, double t, int k, const unsigned char *P, int j,
                      unsigned char *out) {
   const fesd__model *m = &it->model;
   int n_act = 0, i_old = -1;
   for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++)
     if (P[i]) n_act++, i_old = i;
-  int cross = 0;
-  if (n_act == 1) {
+  int cross = 0, alone = -1;
+  {
     fesd__system *S = &it->sys;
     fesd__point_eval pe;
     int st = eval_on_path(it, z, t, &pe);
@@ -238,13 +278,18 @@ static int enter_set(fesd_integrator *it, const double *z, double t, int k, cons
     double tn = 0;
     int n = 0;
     while (n + 1 < S->N && t >= tn + z[S->ho[n]]) tn += z[S->ho[n++]];
-    double ai, aj;
     const double *th = z + fesd__th(S, n, 0);
     fesd__total_field(it, &pe, th, it->ftot);
-    fesd__normal_components(it, &pe, th, it->ftot, i_old, j, &ai, &aj);
-    cross = aj > 0;
+    if (n_act == 1) {
+      double ai, aj;
+      fesd__normal_components(it, &pe, th, it->ftot, i_old, j, &ai, &aj);
+      cross = aj > 0;
+    } else {
+      alone = consistent_alone(it, &pe, th, k, P, j);
+    }
   }
-  for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) out[i] = cross ? i == j : (P[i] || i == j);
+  for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++)
+    out[i] = alone >= 0 ? i == alone : cross ? i == j : (P[i] || i == j);
   return FESD_OK;
 }
 
