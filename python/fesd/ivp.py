@@ -60,6 +60,10 @@ def solve_ivp(model, t_span, y0, *, method="fesd", family="radau", stages=2, n_f
     y0 = np.asarray(y0, dtype=float).reshape(-1)
     if model.nu > 0 and u is None:
         raise ValueError(f"the model has nu = {model.nu}: pass u=")
+    if model.nu == 0 and u is not None and np.size(u) > 0:
+        raise ValueError("the model has nu = 0: u= would be ignored")
+    if int(max_steps) < 1:
+        raise ValueError(f"max_steps must be >= 1 (got {max_steps})")
     it = Integrator(model, method=method, family=family, stages=stages, n_fe=n_fe, sensitivities=sensitivities,
                     events=events, **settings)
     try:

@@ -143,3 +143,8 @@ def test_bad_arguments():
         fesd.Subsystem(3, fields=lambda t, x, u: 0, switch=lambda t, x, u: 0)
     with pytest.raises(ValueError, match="u="):
         fesd.solve_ivp(P.ocp_dynamics(), (0, 1), P.OCP_X0)
+    # a control for a model without controls was ignored; max_steps = 0 returned status -1
+    with pytest.raises(ValueError, match="nu = 0"):
+        fesd.solve_ivp(m, (0, 1), P.OSCILLATOR_X0, u=[1.0])
+    with pytest.raises(ValueError, match="max_steps"):
+        fesd.solve_ivp(m, (0, 1), P.OSCILLATOR_X0, max_steps=0)

@@ -324,6 +324,8 @@ int fesd_set_state(fesd_integrator *it, double t0, const double *x0, const doubl
   it->log_n = 0;
   it->stop_sys = -1;
   it->stop_t = NAN;
+  it->stop_up = 0;
+  it->stop_h = 0;
   it->ec_rejected = 0;
   it->ec_err_prev = 0;
   it->log_pool_n = 0;

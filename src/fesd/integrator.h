@@ -174,6 +174,8 @@ struct fesd_integrator {
   double ec_err_prev;  /* ... and the last accepted error estimate (PI control; 0: none) */
   int stop_sys;      /* the stop condition the last fesd_integrate stopped on (-1: none) */
   double stop_t;     /* ... and when (its crossing at the next step start is not logged again) */
+  int stop_up;       /* ... its direction (1: increasing) */
+  double stop_h;     /* ... and the length of the step that ended on it */
   size_t log_pool_n, log_pool_cap;
   fesd_event *events; /* the last step's events: room for ev_max (accept.c grows it) */
   int n_events, ev_max;

@@ -264,6 +264,8 @@ int fesd__wrap_init(fesd__wrap *w, const fesd_model *user, fesd_model *internal)
   *internal = *user;
   const int td = user->time_dependent != 0, nr = user->n_roots > 0 ? user->n_roots : 0;
   if (user->n_roots < 0 || (nr > 0 && !user->roots)) return FESD_ERR_MODEL;
+  for (int i = 0; i < nr && user->root_dir; i++) /* -1, 0, +1 only (2 or -7 were taken by sign) */
+    if (user->root_dir[i] < -1 || user->root_dir[i] > 1) return FESD_ERR_MODEL;
   if (user->time_dependent != 0 && user->time_dependent != 1) return FESD_ERR_MODEL;
   if (user->sparsity && user->drift && !user->drift_jac) return FESD_ERR_MODEL;
   if (!td && !user->drift && nr == 0) return FESD_OK;

@@ -7,7 +7,14 @@
  *  - a stop condition x = 1/2 on x' in 2 - sign(x), x0 = -1 (x = t - 1/3 after t = 1/3): the
  *    integration stops at t = 5/6 to 1e-12 with FESD_ROOT, and one in the other direction is
  *    passed over;
- *  - the event log holds every event of the integration. */
+ *  - the event log holds every event of the integration;
+ *  - repeated stops: the friction oscillator x'' = -x - sign(x'), x(0) = (5.5, 0), stop at
+ *    x = -2 in both directions over [0, 9]: exactly the 2 crossings of the closed form (acos(-2/3)
+ *    and pi + acos(0.4)), for Radau s = 2..4 and rtol 1e-4..1e-10 (before, a step ending a few
+ *    1e-8 short of its root stopped again on the same crossing: 4 of 21 runs);
+ *  - max_steps bounds fesd_integrate_grid (its dense path integrated step by step and never
+ *    reached it: 6450 steps with max_steps = 50);
+ *  - root_dir outside -1, 0, +1 is refused. */
 #include <math.h>
 #include <stdio.h>
 
@@ -19,6 +26,22 @@ static int root_x(double t, const double *x, const double *u, double *r, void *u
   (void)t, (void)u, (void)user;
   r[0] = x[0] - 0.5;  /* increasing through 0 at t = 5/6 */
   r[1] = x[0] + 0.25; /* increasing at t = 1/4: passed over with direction -1 */
+  return 0;
+}
+
+static int fo_field(int sys, int mode, double t, const double *x, const double *u, double *f, void *user) {
+  (void)sys, (void)t, (void)u, (void)user;
+  f[0] = x[1], f[1] = -x[0] + (mode == 0 ? -1.0 : 1.0);
+  return 0;
+}
+static int fo_sw(int sys, double t, const double *x, const double *u, double *c, void *user) {
+  (void)sys, (void)t, (void)u, (void)user;
+  c[0] = x[1];
+  return 0;
+}
+static int fo_root(double t, const double *x, const double *u, double *r, void *user) {
+  (void)t, (void)u, (void)user;
+  r[0] = x[0] + 2.0;
   return 0;
 }
 
@@ -147,6 +170,73 @@ int main(void) {
                     steps_each, rej_each, info.steps, info.rejected);
     printf("oscillator rtol 1e-8: one call, step by step and the grid: %d steps, %d rejected, the same x(T)\n",
            steps_one, rej_one);
+    fesd_free(&it);
+  }
+  {
+    /* repeated stops on one crossing */
+    const int nm[1] = {2}, ns[1] = {1};
+    int dir[1] = {0};
+    fesd_model fo = {.nx = 2, .nsys = 1, .n_modes = nm, .n_switch = ns, .field = fo_field, .sw = fo_sw,
+                     .n_roots = 1, .roots = fo_root, .root_dir = dir};
+    const double tc[2] = {acos(-2.0 / 3.0), 3.14159265358979323846 + acos(0.4)};
+    int runs = 0, right = 0;
+    double worst = 0;
+    for (int s = 2; s <= 4; s++)
+      for (int e = 4; e <= 10; e++) {
+        fesd_settings set;
+        fesd_settings_default(&set);
+        set.stages = s;
+        fesd_integrator *it;
+        fesd_create(&it, &fo, &set);
+        fesd_tolerances tl;
+        fesd_tolerances_default(&tl);
+        tl.rtol = pow(10.0, -e), tl.atol = 1e-2 * tl.rtol;
+        fesd_set_tolerances(it, &tl);
+        const double x0[2] = {5.5, 0};
+        fesd_set_state(it, 0, x0, NULL);
+        int nstop = 0, st = FESD_ROOT;
+        double tstop[8];
+        while (st == FESD_ROOT) {
+          fesd_integrate_info info;
+          st = fesd_integrate(it, NULL, 9.0, &info);
+          if (st == FESD_ROOT && nstop < 8) tstop[nstop++] = info.t;
+        }
+        runs++;
+        const int ok = st == FESD_OK && nstop == 2;
+        right += ok;
+        if (ok) worst = fmax(worst, fmax(fabs(tstop[0] - tc[0]), fabs(tstop[1] - tc[1])) / tl.rtol);
+        FESD_TEST_CHECK(ok, "friction oscillator s=%d rtol 1e-%d: %s after %d stops (2 crossings)", s, e,
+                        fesd_status_name(st), nstop);
+        fesd_free(&it);
+      }
+    printf("stops at x = -2 of the friction oscillator: %d of %d runs with exactly the 2 crossings (stop times within "
+           "%.2g rtol)\n",
+           right, runs, worst);
+    /* max_steps bounds the grid */
+    fesd_settings set;
+    fesd_settings_default(&set);
+    fesd_integrator *it;
+    fesd_create(&it, &fo, &set);
+    fesd_tolerances tl;
+    fesd_tolerances_default(&tl);
+    tl.rtol = 1e-10, tl.max_steps = 50;
+    fesd_set_tolerances(it, &tl);
+    const double x0[2] = {5.5, 0}, tg[3] = {1, 2, 12};
+    double xg[6];
+    fesd_set_state(it, 0, x0, NULL);
+    dir[0] = 0;
+    fesd_integrate_info info;
+    int st = fesd_integrate_grid(it, NULL, 3, tg, xg, &info);
+    while (st == FESD_ROOT) st = fesd_integrate_grid(it, NULL, 3, tg, xg, &info);
+    printf("grid with max_steps = 50: %s after %d + %d steps\n", fesd_status_name(st), info.steps, info.rejected);
+    FESD_TEST_CHECK(st == FESD_ERR_TOO_MANY_STEPS && info.steps + info.rejected <= 50, "grid: %s after %d + %d steps",
+                    fesd_status_name(st), info.steps, info.rejected);
+    fesd_free(&it);
+    /* root_dir range */
+    dir[0] = 2;
+    FESD_TEST_CHECK(fesd_create(&it, &fo, &set) == FESD_ERR_MODEL, "root_dir 2 accepted");
+    dir[0] = -7;
+    FESD_TEST_CHECK(fesd_create(&it, &fo, &set) == FESD_ERR_MODEL, "root_dir -7 accepted");
     fesd_free(&it);
   }
   printf("%d failures\n", fails);
