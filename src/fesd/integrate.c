@@ -284,6 +284,8 @@ static int integrate(fesd_integrator *it, const double *u, double t_out, fesd_in
     const double left = t_out - it->t, t_start = it->t;
     double hh = h >= 0.99 * left ? left : (h > 0.5 * left ? 0.5 * left : h);
     fesd_step_info si;
+    if (!(it->ap_t == it->t) && (st = fesd__graze_rates(it, u, it->ap_lam, it->ap_rate))) break;
+    it->ap_t = it->t;
     it->newton_tol = solve_tolerance(it);
     st = fesd_step(it, u, hh, &si);
     info->newton_iter += si.newton_iter;
@@ -316,6 +318,19 @@ static int integrate(fesd_integrator *it, const double *u, double t_out, fesd_in
       }
       continue;
     }
+    /* a graze inside the step (graze.c): retried to end at it */
+    if ((st = fesd__graze_rates(it, u, it->ap_lam_b, it->ap_rate_b))) break;
+    const double t_dip = fesd__graze_dip(it, hh, it->ap_lam, it->ap_rate, it->ap_lam_b, it->ap_rate_b);
+    if (t_dip > 0) {
+      rollback(it);
+      info->rejected++;
+      it->ec_rejected = 1;
+      h = fmax(t_dip, hmin);
+      continue;
+    }
+    memcpy(it->ap_lam, it->ap_lam_b, (size_t)it->nth * sizeof(double));
+    memcpy(it->ap_rate, it->ap_rate_b, (size_t)it->nth * sizeof(double));
+    it->ap_t = it->t;
     double t_root;
     int root_dir = 0;
     const int root = root_crossed(it, t_start + 1e-12 * fmax(1.0, fabs(t_start)), &t_root, &root_dir);

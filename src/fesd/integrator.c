@@ -141,6 +141,11 @@ static void lay_out(fesd_integrator *it, const fesd_settings *settings, fesd__bl
   it->x = fesd__block_doubles(B, nx);
   it->lam00 = fesd__block_doubles(B, nth);
   it->theta_prev = fesd__block_doubles(B, nth);
+  it->ap_lam = fesd__block_doubles(B, nth);
+  it->ap_rate = fesd__block_doubles(B, nth);
+  it->ap_lam_b = fesd__block_doubles(B, nth);
+  it->ap_rate_b = fesd__block_doubles(B, nth);
+  it->ap_th = fesd__block_doubles(B, nth);
   it->u_cur = fesd__block_doubles(B, nu);
   it->ws_blk = fesd__block_doubles(B, (size_t)S->sb);
   it->z = fesd__block_doubles(B, n);
@@ -324,6 +329,7 @@ int fesd_set_state(fesd_integrator *it, double t0, const double *x0, const doubl
   it->log_n = 0;
   it->stop_sys = -1;
   it->stop_t = NAN;
+  it->ap_t = NAN;
   it->stop_up = 0;
   it->stop_h = 0;
   it->ec_rejected = 0;

@@ -84,6 +84,9 @@ struct fesd_integrator {
   double *f0;  /* the fields at the step start (nF), when f0_ok: from the guess's stage Newton */
   int f0_ok;   /* reset at each step attempt (try_step) */
   double *x, *lam00, *theta_prev, *u_cur, *ws_blk; /* ws_blk: last stage block of the last step */
+  /* graze check of fesd_integrate (graze.c): lambda and its rate at the start of the step (a)
+   * and at its end (b), per mode; ap_th scratch thetas; ap_t: the time the (a) values hold at */
+  double *ap_lam, *ap_rate, *ap_lam_b, *ap_rate_b, *ap_th, ap_t;
   int have_state, have_ws, have_prev_theta;
   /* step data (sized for N_cap elements) */
   double *z, *z0, *zpred, *zp, *raw;
@@ -208,6 +211,10 @@ void fesd__load(fesd_integrator *it, const fesd__saved *b);
 int fesd__use_level(fesd_integrator *it, int N);
 /* The element count of the ladder that holds at least N elements (at most N_cap). */
 int fesd__ladder(const fesd_integrator *it, int N);
+/* Graze check of an error-controlled step (graze.c). */
+int fesd__graze_rates(fesd_integrator *it, const double *u, double *lam, double *rate);
+double fesd__graze_dip(const fesd_integrator *it, double hh, const double *lam_a, const double *rate_a,
+                       const double *lam_b, const double *rate_b);
 /* Whether the method has a collocation polynomial (dense output, interior checks). */
 int fesd__collocation(const fesd_integrator *it);
 
