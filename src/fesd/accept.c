@@ -397,12 +397,13 @@ int fesd__accept(fesd_integrator *it, const double *z, const double *u, double T
     /* events at the left boundary of element n */
     for (int k = 0; k < nsys; k++) {
       int *b = event_room(it);
-      /* the first step after fesd_set_state: against the start's classification, so that a
-       * switch the plan moved to the start (an entry 1e-9 T after it) is logged as in any
-       * later step */
+      /* the first step after fesd_set_state: when the plan moved a switch to the start (an
+       * entry 1e-9 T after it), against the start's classification, so that it is logged as in
+       * any later step (otherwise nothing to compare: element 0's modes at any stage would
+       * show a crossing inside element 0 of the standard method as an entry at t0) */
+      if (n == 0 && !it->have_prev_theta && !it->start_jumped) continue;
       int nb = n > 0 ? element_modes(it, z, n - 1, k, b)
-               : it->have_prev_theta ? active_modes(it, it->theta_prev, k, b)
-                                     : flagged_modes(it, it->start_jumped ? it->act_first : it->act0, k, b);
+               : it->have_prev_theta ? active_modes(it, it->theta_prev, k, b) : flagged_modes(it, it->act_first, k, b);
       add_event(it, t, k, b, nb, element_modes(it, z, n, k, b + nb));
     }
     t += z[S->ho[n]];

@@ -7,7 +7,8 @@
  * min g) and its rate along the field are known at both ends of an accepted step; when they
  * show a minimum inside (falling at the start, rising at the end, no switch of the subsystem in
  * the step), the cubic Hermite interpolant through them locates it, exactly for the parabolic
- * arrival of a graze. A minimum below the surface rejects the step, and the retry ends at it. */
+ * arrival of a graze. A minimum below the surface rejects the step, and the retry ends at it
+ * (integrate.c: without the rounding of step lengths to the span). */
 #include <math.h>
 #include <string.h>
 
@@ -85,7 +86,9 @@ double fesd__graze_dip(const fesd_integrator *it, double hh, const double *lam_a
   double t_dip = 0;
   for (int k = 0; k < m->nsys; k++) {
     int switched = 0;
-    for (int e = 0; e < ne && !switched; e++) switched = ev[e].sys == k;
+    /* a stop condition's event names its index among the conditions, not its subsystem */
+    for (int e = 0; e < ne && !switched; e++)
+      switched = (ev[e].kind == FESD_EVENT_ROOT ? ev[e].sys + it->wrap.kr : ev[e].sys) == k;
     if (switched) continue;
     for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) {
       /* inactive at both ends (lambda > 0 beyond round-off), falling, then rising */

@@ -272,7 +272,10 @@ static int integrate(fesd_integrator *it, const double *u, double t_out, fesd_in
   const double span = t_out - it->t, hmax = it->tol.h_max > 0 ? it->tol.h_max : INFINITY;
   double h = it->h_next > 0 ? it->h_next : it->tol.h_init > 0 ? it->tol.h_init : first_step(it, u, span);
   const double hmin = it->tol.h_min > 0 ? it->tol.h_min : 1e-14 * fmax(fabs(it->t), fabs(t_out));
-  int st = FESD_OK;
+  int st = FESD_OK, graze_retry = 0;
+  /* the graze check's values at the start: again on every call (u or the callbacks' data may
+   * have changed since the last one at this time) */
+  it->ap_t = NAN;
   /* the controller's memory (it->ec_rejected, it->ec_err_prev) lives in the integrator: one
    * call or many (fesd_integrate_grid steps one at a time) take the same steps */
   while (it->t < t_out) {
@@ -282,7 +285,10 @@ static int integrate(fesd_integrator *it, const double *u, double t_out, fesd_in
     }
     h = fmin(h, hmax);
     const double left = t_out - it->t, t_start = it->t;
-    double hh = h >= 0.99 * left ? left : (h > 0.5 * left ? 0.5 * left : h);
+    /* a retry after a graze ends at the dip (the rounding to the span could repeat the step
+     * whose last 1 % holds it, forever) */
+    double hh = graze_retry ? fmin(h, left) : h >= 0.99 * left ? left : (h > 0.5 * left ? 0.5 * left : h);
+    graze_retry = 0;
     fesd_step_info si;
     if (!(it->ap_t == it->t) && (st = fesd__graze_rates(it, u, it->ap_lam, it->ap_rate))) break;
     it->ap_t = it->t;
@@ -326,6 +332,7 @@ static int integrate(fesd_integrator *it, const double *u, double t_out, fesd_in
       info->rejected++;
       it->ec_rejected = 1;
       h = fmax(t_dip, hmin);
+      graze_retry = 1;
       continue;
     }
     memcpy(it->ap_lam, it->ap_lam_b, (size_t)it->nth * sizeof(double));

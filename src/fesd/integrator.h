@@ -202,7 +202,7 @@ static inline fesd__point_eval fesd__scratch_eval(const fesd_integrator *it) {
 /* w_j = int_0^tau l_j (Lagrange basis on the nodes c): the collocation polynomial of an
  * element is x_n + h sum_j w_j(tau) v_j. w has s entries. */
 void fesd__colloc_weights(const fesd_integrator *it, double tau, double *w);
-/* Fill n_mid, mid_tau, mid_w and mid_stage (verify.c). */
+/* Fill n_mid, mid_tau, mid_w and mid_stage (verify_between.c). */
 void fesd__interior_setup(fesd_integrator *it);
 void fesd__save(fesd_integrator *it, fesd__saved *b);
 void fesd__load(fesd_integrator *it, const fesd__saved *b);

@@ -391,6 +391,7 @@ int fesd_ocp_solve(fesd_ocp *o, fesd_ocp_info *info) {
    * infeasibility 2.1, where the guess converges to 23.763): a failed solve from it is repeated
    * from the guess; the better best iterate of the two is returned. */
   if (pre && st != FESD_OK && st != FESD_ERR_NOMEM && !o->warm) {
+    const int st_pre = st;
     say(o, "from the presolve: %s; again from the guess", fesd_status_name(st));
     memcpy(o->cur->w, o->wg, (size_t)o->nw * sizeof(double));
     memset(o->y, 0, (size_t)m * sizeof(double));
@@ -404,6 +405,9 @@ int fesd_ocp_solve(fesd_ocp *o, fesd_ocp_info *info) {
       const double best = o->best_score;
       st = iterate(o, 0);
       o->info.presolve_used = o->best_score < best ? 0 : 1;
+      if (o->info.presolve_used) st = st_pre; /* the status of the run whose iterate is returned */
+    } else if (st != FESD_ERR_NOMEM) {
+      st = st_pre; /* the guess cannot be evaluated: the first run's iterate and status stand */
     }
   }
   /* the returned iterate: the best one (the last one on success) */
