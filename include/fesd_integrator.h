@@ -281,7 +281,9 @@ FESD_API int fesd_create(fesd_integrator **it, const fesd_model *model,
 FESD_API void fesd_free(fesd_integrator **it);
 
 /** @brief Set the current time and state; resets sensitivities to identity/zero and
- *         computes lambda_{0,0} = g(x0) - min g(x0). u is used to evaluate g. */
+ *         computes lambda_{0,0} = g(x0) - min g(x0). u is used to evaluate g.
+ *         FESD_ERR_MODEL when model.time_dependent = 0 but the switching functions, stop
+ *         conditions or fields at x0 change with t (compared at t0 and a later time). */
 FESD_API int fesd_set_state(fesd_integrator *it, double t0, const double *x0, const double *u);
 
 /**

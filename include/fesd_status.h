@@ -38,7 +38,7 @@ extern "C" {
   X(FESD_ERR_STEP_FAILED, -14, "integration step failed after all recovery attempts")   \
   X(FESD_ERR_TOO_MANY_SWITCHES, -15, "too many switches (Zeno-like accumulation): stopped") \
   X(FESD_ERR_SIGN_MATRIX, -16, "sign matrix has repeated rows or zero entries")         \
-  X(FESD_ERR_MODEL, -17, "invalid model (missing callback or bad dimensions)")          \
+  X(FESD_ERR_MODEL, -17, "invalid model (missing callback, bad dimensions, or callbacks that depend on t with time_dependent = 0)") \
   X(FESD_ERR_NOT_READY, -18, "object is not in a state that allows this call")          \
   X(FESD_ERR_TOO_MANY_STEPS, -19, "maximum number of steps reached before the output time") \
   X(FESD_ERR_STEP_TOO_SMALL, -20, "step size fell below its minimum (error or convergence failures)") \

@@ -303,6 +303,36 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   return FESD_OK;
 }
 
+/* A model declared time-independent (time_dependent = 0) whose callbacks depend on t: the step
+ * system's derivatives leave out d/dt, and a switch that only time drives cannot be solved
+ * (measured: a stop condition r = t - 0.9 ended FESD_ERR_STEP_TOO_SMALL after 36 failed
+ * attempts, with nothing saying why). The indicators and the sum of the mode fields at x0 are
+ * compared at t0 and a later time; any difference is FESD_ERR_MODEL. */
+static int check_autonomous(fesd_integrator *it, const double *u) {
+  fesd__model *m = &it->model;
+  const int nx = m->nx, nth = m->nth;
+  double *g0 = it->gbuf, *f0 = it->ftot, *f1 = it->ftot + nx;
+  for (int pass = 0; pass < 2; pass++) {
+    const double t = pass ? it->t + 1e-3 * fmax(1.0, fabs(it->t)) + 0.5 : it->t;
+    fesd__point_eval pe = fesd__scratch_eval(it);
+    pe.dgdx = NULL;
+    int st = fesd__model_eval(m, t, it->x, u, &pe);
+    if (st) return st;
+    double *f = pass ? f1 : f0;
+    memset(f, 0, (size_t)nx * sizeof(double));
+    for (int i = 0; i < nth; i++) fesd__F_axpy(m, &pe, i, 1.0, f);
+    if (!pass) {
+      memcpy(g0, pe.g, (size_t)nth * sizeof(double));
+      continue;
+    }
+    for (int i = 0; i < nth; i++)
+      if (pe.g[i] != g0[i]) return FESD_ERR_MODEL;
+    for (int r = 0; r < nx; r++)
+      if (f1[r] != f0[r]) return FESD_ERR_MODEL;
+  }
+  return FESD_OK;
+}
+
 int fesd_set_state(fesd_integrator *it, double t0, const double *x0, const double *u) {
   if (!it || !x0 || (it->nu > 0 && !u)) return FESD_ERR_NULL;
   if (!isfinite(t0)) return FESD_ERR_INVALID_ARG;
@@ -337,6 +367,7 @@ int fesd_set_state(fesd_integrator *it, double t0, const double *x0, const doubl
   it->log_pool_n = 0;
   /* lambda00 = g(x0) - min g (paper Sec. 3.2.2), with its derivative for sensitivities */
   int st = fesd__update_lambda00(it, it->x, u, it->set.sensitivities, NULL);
+  if (st == FESD_OK && !it->wrap.td) st = check_autonomous(it, u);
   it->have_state = (st == FESD_OK);
   return st;
 }

@@ -69,6 +69,19 @@ int main(void) {
   const int dir[1] = {-1};
   fesd_model mr = m;
   mr.n_roots = 1, mr.roots = root_t, mr.root_dir = dir;
+  {
+    /* the root depends on t: declared time-independent, fesd_set_state refuses the model (a root
+     * crossing 1e-4 after a switch ended FESD_ERR_STEP_TOO_SMALL, nothing saying why) */
+    fesd_integrator *it;
+    fesd_settings set;
+    fesd_settings_default(&set);
+    const double x0[2] = {-0.5, 1};
+    int st = fesd_create(&it, &mr, &set);
+    if (!st) st = fesd_set_state(it, 0, x0, NULL);
+    HD_CHECK(st == FESD_ERR_MODEL, "a t-dependent root with time_dependent = 0: %s", fesd_status_name(st));
+    fesd_free(&it);
+  }
+  mr.time_dependent = 1;
   int rruns = 0, rright = 0;
   for (int s = 2; s <= 4; s++)
     for (int i = 0; i <= 50; i += 2) {
