@@ -151,5 +151,17 @@ int fesd__ocp_model_init(fesd_ocp *o) {
   /* exact drift Jacobian unless the user's drift has none (then central differences of all) */
   a->drift_jac = (!m->drift || m->drift_jac) ? m_drift_jac : NULL;
   a->roots = m->n_roots > 0 ? m_roots : NULL;
+  if (!m->time_dependent) {
+    /* A Lagrange term that depends on t makes the cost state's field depend on t, so the
+     * integrator needs t as a state (fesd_set_state refuses a model declared time-independent
+     * whose fields change with t: a cost weighted by (1 + t / 2) on time-independent dynamics).
+     * Probed at x0 with the controls at 0 clamped into their bounds. */
+    double *u = o->d, L0 = 0, L1 = 0;
+    for (int j = 0; j < o->nu; j++) u[j] = fmin(fmax(0.0, o->u_lb[j]), o->u_ub[j]);
+    const double t0 = o->p.t0, t1 = t0 + 1e-3 * fmax(1.0, fabs(t0)) + 0.5;
+    if (!lagrange_eval(o, t0, o->x0, u, &L0, NULL, NULL) && !lagrange_eval(o, t1, o->x0, u, &L1, NULL, NULL) &&
+        L0 != L1)
+      a->time_dependent = 1;
+  }
   return FESD_OK;
 }
