@@ -155,13 +155,18 @@ int fesd__ocp_model_init(fesd_ocp *o) {
     /* A Lagrange term that depends on t makes the cost state's field depend on t, so the
      * integrator needs t as a state (fesd_set_state refuses a model declared time-independent
      * whose fields change with t: a cost weighted by (1 + t / 2) on time-independent dynamics).
-     * Probed at x0 with the controls at 0 clamped into their bounds. */
-    double *u = o->d, L0 = 0, L1 = 0;
-    for (int j = 0; j < o->nu; j++) u[j] = fmin(fmax(0.0, o->u_lb[j]), o->u_ub[j]);
+     * Probed at three points (x0 + q, controls q clamped into their bounds, q = 0, 1, -1: at
+     * x0 = 0, u = 0 a weight (1 + t) u^2 shows nothing) at t0 and a later time. */
+    double *u = o->d, *x = o->d + o->nu;
     const double t0 = o->p.t0, t1 = t0 + 1e-3 * fmax(1.0, fabs(t0)) + 0.5;
-    if (!lagrange_eval(o, t0, o->x0, u, &L0, NULL, NULL) && !lagrange_eval(o, t1, o->x0, u, &L1, NULL, NULL) &&
-        L0 != L1)
-      a->time_dependent = 1;
+    for (int q = 0; q < 3 && !a->time_dependent; q++) {
+      const double v = q == 0 ? 0.0 : q == 1 ? 1.0 : -1.0;
+      for (int j = 0; j < o->nu; j++) u[j] = fmin(fmax(v, o->u_lb[j]), o->u_ub[j]);
+      for (int i = 0; i < o->nx; i++) x[i] = o->x0[i] + v;
+      double L0 = 0, L1 = 0;
+      if (!lagrange_eval(o, t0, x, u, &L0, NULL, NULL) && !lagrange_eval(o, t1, x, u, &L1, NULL, NULL) && L0 != L1)
+        a->time_dependent = 1;
+    }
   }
   return FESD_OK;
 }

@@ -10,7 +10,13 @@
  * the free controls, and the bound multipliers from the same equation on u_0 and u_3 (their signs
  * are the check of the KKT conditions). Checked: controls, states, objective, multipliers and
  * their signs, KKT residuals, for the Gauss-Newton and the BFGS Hessian, FESD and standard
- * (identical here: no switch). */
+ * (identical here: no switch).
+ * And a cost weighted in time, int (1 + t) u^2 on the same time-independent model, without
+ * control bounds: the interval weights W_k = h (1 + t_k + h/2) (the cost state integrates the
+ * linear weight exactly), u_k = (a h + b c_k) / (2 W_k) with c_k = h^2 (N - k - 1/2), a and b
+ * from the two terminal conditions (the OCP makes its model time-dependent for such a term; at
+ * x0 = 0 with u = 0 the weight shows nothing, so it probes more points: with x0 and u = 0 only,
+ * the integrator's check of the t-dependence refused the model, FESD_ERR_MODEL). */
 #include <math.h>
 #include <stdio.h>
 
@@ -51,6 +57,13 @@ static int lagrange(double t, const double *x, const double *u, double *l, doubl
   l[0] = u[0] * u[0];
   if (lx) lx[0] = lx[1] = 0;
   if (lu) lu[0] = 2 * u[0];
+  return 0;
+}
+static int lagrange_t(double t, const double *x, const double *u, double *l, double *lx, double *lu, void *user) {
+  (void)x, (void)user;
+  l[0] = (1 + t) * u[0] * u[0];
+  if (lx) lx[0] = lx[1] = 0;
+  if (lu) lu[0] = 2 * (1 + t) * u[0];
   return 0;
 }
 static int terminal(double t, const double *x, const double *u, double *e, double *ex, double *eu, void *user) {
@@ -132,6 +145,39 @@ int main(void) {
     CHECK(fabs(m.dynamics[2 * (N - 1)] - b) <= 1e-6 * fabs(b) && fabs(m.dynamics[2 * (N - 1) + 1] - a) <= 1e-6 * fabs(a),
           "variant %d: last costate %.9g %.9g", variant, m.dynamics[2 * (N - 1)], m.dynamics[2 * (N - 1) + 1]);
     if (!bfgs) CHECK(info.iterations <= 3, "Gauss-Newton is exact here: %d iterations", info.iterations);
+    fesd_ocp_free(&o);
+  }
+  {
+    /* the time-weighted cost */
+    const int nm[1] = {2}, ns[1] = {1};
+    fesd_model mod = {.nx = 2, .nu = 1, .nsys = 1, .n_modes = nm, .n_switch = ns, .field = field,
+                      .field_jac = field_jac, .sw = sw, .sw_jac = sw_jac};
+    const double z0[2] = {0, 0}, tb2[2] = {1, 0}, hh = 1.0 / N;
+    fesd_ocp_problem p = {.model = &mod, .n_ctrl = N, .t0 = 0, .tf = 1, .x0 = z0, .lagrange = lagrange_t,
+                          .n_term = 2, .terminal = terminal, .term_lb = tb2, .term_ub = tb2};
+    fesd_ocp_settings set;
+    fesd_ocp_settings_default(&set);
+    fesd_ocp *o;
+    CHECK(fesd_ocp_create(&o, &p, &set) == FESD_OK, "create (time-weighted cost)");
+    fesd_ocp_info info;
+    const int st = fesd_ocp_solve(o, &info);
+    double u[N];
+    fesd_ocp_get_solution(o, NULL, u);
+    double A11 = 0, A12 = 0, A22 = 0, W[N], c[N];
+    for (int k = 0; k < N; k++) {
+      W[k] = hh * (1 + k * hh + hh / 2), c[k] = hh * hh * (N - k - 0.5);
+      A11 += hh * hh / (2 * W[k]), A12 += hh * c[k] / (2 * W[k]), A22 += c[k] * c[k] / (2 * W[k]);
+    }
+    const double det = A11 * A22 - A12 * A12, aa = -A12 / det, bb = A11 / det; /* [A](a, b) = (0, 1) */
+    double J = 0, du = 0;
+    for (int k = 0; k < N; k++) {
+      const double uk = (aa * hh + bb * c[k]) / (2 * W[k]);
+      J += W[k] * uk * uk, du = fmax(du, fabs(u[k] - uk));
+    }
+    printf("time-weighted cost: %s in %d iterations, f %.12f (exact %.12f), controls within %.1e\n",
+           fesd_status_name(st), info.iterations, info.objective, J, du);
+    CHECK(st == FESD_OK && fabs(info.objective - J) <= 1e-8 * J && du <= 1e-6, "time-weighted cost: %s, f %.12f vs %.12f",
+          fesd_status_name(st), info.objective, J);
     fesd_ocp_free(&o);
   }
   if (fails) printf("%d check(s) failed\n", fails);
