@@ -26,6 +26,14 @@ void fesd__act_from_theta(const fesd_integrator *it, const double *theta, unsign
   }
 }
 
+int fesd__keeps_alone(const fesd__model *m, const fesd__point_eval *pe, int k, const unsigned char *cand, int l,
+                      const double *f) {
+  const double gl = fesd__dg_dot(m, pe, l, f);
+  for (int c = m->th_off[k]; c < m->th_off[k + 1]; c++)
+    if (c != l && cand[c] && !(fesd__dg_dot(m, pe, c, f) - gl > 0)) return 0;
+  return 1;
+}
+
 /* x0 on a switching surface (several modes tie for min g). A tied mode i whose field keeps it
  * the strict minimum, d/dt (g_j - g_i) > 0 along the total field with f_i for every other tied
  * j, leaves the surface on its own side. Exactly one such mode: it is entered alone (a
@@ -55,17 +63,12 @@ static int resolve_ties(fesd_integrator *it, const double *u, unsigned char *a, 
     for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) {
       if (!a[i]) continue;
       if (imin < 0 || pe.g[i] < pe.g[imin]) imin = i;
-      int ok = 1;
-      for (int j = m->th_off[k]; j < m->th_off[k + 1] && ok; j++) {
-        if (j == i || !a[j]) continue;
-        /* total field with mode i alone in subsystem k */
-        memcpy(f, ftot, (size_t)nx * sizeof(double));
-        fesd__F_axpy(m, &pe, i, 1.0, f);
-        for (int l = m->th_off[k]; l < m->th_off[k + 1]; l++)
-          if (a[l]) fesd__F_axpy(m, &pe, l, -1.0 / cnt, f);
-        ok = fesd__dg_dot(m, &pe, j, f) - fesd__dg_dot(m, &pe, i, f) > 0;
-      }
-      if (ok) pick = pick < 0 ? i : pick, n_ok++;
+      /* total field with mode i alone in subsystem k */
+      memcpy(f, ftot, (size_t)nx * sizeof(double));
+      fesd__F_axpy(m, &pe, i, 1.0, f);
+      for (int l = m->th_off[k]; l < m->th_off[k + 1]; l++)
+        if (a[l]) fesd__F_axpy(m, &pe, l, -1.0 / cnt, f);
+      if (fesd__keeps_alone(m, &pe, k, a, i, f)) pick = pick < 0 ? i : pick, n_ok++;
     }
     if (n_ok >= 2) { /* repulsive: the side of the state, unless exactly on the surface */
       int strict = 1;

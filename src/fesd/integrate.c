@@ -118,18 +118,21 @@ static double first_step(fesd_integrator *it, const double *u, double span) {
   return fmin(fmin(100 * h0, h1), span);
 }
 
+/* Whether a stop condition's event is a crossing into r > 0 ({1} -> {0}). */
+static int crosses_up(const fesd_event *ev) { return ev->n_after == 1 && ev->after[0] == 0; }
+
 /* The step that stopped ends on its root only to the method's accuracy, perhaps a little short
  * of it: the next step then crosses the same condition, in the same direction, at once (or at
  * its start). That is the stop already taken (measured: stops at 4.300870529 and 4.300870541
  * for one crossing at 4.300872134, Radau s = 2, rtol 1e-4; 3 of 21 runs logged both). */
 static int same_stop(const fesd_integrator *it, const fesd_event *ev) {
-  const int up = ev->n_after == 1 && ev->after[0] == 0;
+  const int up = crosses_up(ev);
   return ev->sys == it->stop_sys && (ev->t == it->stop_t || (up == it->stop_up && ev->t - it->stop_t <= 1e-6 * it->stop_h));
 }
 
 /* A zero crossing of stop condition ev->sys in its direction (model.root_dir). */
 static int root_wanted(const fesd_integrator *it, const fesd_event *ev) {
-  const int up = ev->n_after == 1 && ev->after[0] == 0; /* into r > 0 */
+  const int up = crosses_up(ev);
   const int dir = it->wrap.user.root_dir ? it->wrap.user.root_dir[ev->sys] : 0;
   return !((dir > 0 && !up) || (dir < 0 && up));
 }
@@ -215,7 +218,7 @@ static int root_crossed(const fesd_integrator *it, double t_from, double *t_root
     if (same_stop(it, &ev[e])) continue;
     if (best < 0 || ev[e].t < ev[best].t) best = e;
   }
-  if (best >= 0) *t_root = ev[best].t, *dir = ev[best].n_after == 1 && ev[best].after[0] == 0 ? 1 : -1;
+  if (best >= 0) *t_root = ev[best].t, *dir = crosses_up(&ev[best]) ? 1 : -1;
   return best >= 0 ? ev[best].sys : -1;
 }
 

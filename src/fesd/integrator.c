@@ -308,28 +308,32 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
  * (measured: a stop condition r = t - 0.9 ended FESD_ERR_STEP_TOO_SMALL after 36 failed
  * attempts, with nothing saying why). The indicators and the sum of the mode fields at x0 are
  * compared at t0 and a later time; any difference is FESD_ERR_MODEL. */
-static int check_autonomous(fesd_integrator *it, const double *u) {
+/* The sum of the mode fields (f) at x0 at time t, and the indicators (*g: the scratch point's,
+ * valid until its next use). */
+static int autonomy_probe(fesd_integrator *it, double t, const double *u, double *f, const double **g) {
   fesd__model *m = &it->model;
-  const int nx = m->nx, nth = m->nth;
+  fesd__point_eval pe = fesd__scratch_eval(it);
+  pe.dgdx = NULL;
+  int st = fesd__model_eval(m, t, it->x, u, &pe);
+  if (st) return st;
+  memset(f, 0, (size_t)m->nx * sizeof(double));
+  for (int i = 0; i < m->nth; i++) fesd__F_axpy(m, &pe, i, 1.0, f);
+  *g = pe.g;
+  return FESD_OK;
+}
+
+static int check_autonomous(fesd_integrator *it, const double *u) {
+  const int nx = it->model.nx, nth = it->model.nth;
   double *g0 = it->gbuf, *f0 = it->ftot, *f1 = it->ftot + nx;
-  for (int pass = 0; pass < 2; pass++) {
-    const double t = pass ? it->t + 1e-3 * fmax(1.0, fabs(it->t)) + 0.5 : it->t;
-    fesd__point_eval pe = fesd__scratch_eval(it);
-    pe.dgdx = NULL;
-    int st = fesd__model_eval(m, t, it->x, u, &pe);
-    if (st) return st;
-    double *f = pass ? f1 : f0;
-    memset(f, 0, (size_t)nx * sizeof(double));
-    for (int i = 0; i < nth; i++) fesd__F_axpy(m, &pe, i, 1.0, f);
-    if (!pass) {
-      memcpy(g0, pe.g, (size_t)nth * sizeof(double));
-      continue;
-    }
-    for (int i = 0; i < nth; i++)
-      if (pe.g[i] != g0[i]) return FESD_ERR_MODEL;
-    for (int r = 0; r < nx; r++)
-      if (f1[r] != f0[r]) return FESD_ERR_MODEL;
-  }
+  const double *g;
+  int st = autonomy_probe(it, it->t, u, f0, &g);
+  if (st) return st;
+  memcpy(g0, g, (size_t)nth * sizeof(double));
+  if ((st = autonomy_probe(it, it->t + 1e-3 * fmax(1.0, fabs(it->t)) + 0.5, u, f1, &g))) return st;
+  for (int i = 0; i < nth; i++)
+    if (g[i] != g0[i]) return FESD_ERR_MODEL;
+  for (int r = 0; r < nx; r++)
+    if (f1[r] != f0[r]) return FESD_ERR_MODEL;
   return FESD_OK;
 }
 

@@ -305,3 +305,10 @@ int fesd__two_modes(const fesd__model *m, const unsigned char *a, int k, int *j)
     }
   return cnt == 2 ? i : -1;
 }
+
+int fesd__any_two_modes(const fesd__model *m, const unsigned char *a) {
+  int j;
+  for (int k = 0; k < m->nsys; k++)
+    if (fesd__two_modes(m, a, k, &j) >= 0) return 1;
+  return 0;
+}

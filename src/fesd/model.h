@@ -69,6 +69,8 @@ int fesd__model_g(fesd__model *m, double t, const double *x, const double *u, do
 /* The two active modes (flags a, one per stacked mode) of subsystem k: returns the first and
  * writes the second to *j when exactly two are active (a 2-mode sliding mode), else -1. */
 int fesd__two_modes(const fesd__model *m, const unsigned char *a, int k, int *j);
+/* Whether some subsystem has exactly two active modes in a (a 2-mode sliding mode). */
+int fesd__any_two_modes(const fesd__model *m, const unsigned char *a);
 void fesd__F_axpy(const fesd__model *m, const fesd__point_eval *pe, int i, double a, double *y);
 /* g = v - sum_i theta_i F_i at the evaluated point: the residual of a stage equation (the step
  * system's V rows, the guess's stage Newton, the certified start solve). */

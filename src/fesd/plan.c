@@ -242,19 +242,17 @@ static int consistent_alone(fesd_integrator *it, const fesd__point_eval *pe, con
   /* candidates: P, j, and the modes tied with them at the point (the far side of the corner) */
   for (int l = m->th_off[k]; l < m->th_off[k + 1]; l++)
     cand[l] = P[l] || l == j || (pe->g[l] - gmin) * it->sys.wth[l] <= CORNER_TIE;
+  /* the total field without subsystem k, then with each candidate alone */
+  double *rest = f + nx;
+  memcpy(rest, it->ftot, (size_t)nx * sizeof(double));
+  for (int q = m->th_off[k]; q < m->th_off[k + 1]; q++)
+    if (th[q] != 0.0) fesd__F_axpy(m, pe, q, -th[q], rest);
   int pick = -1, n_ok = 0;
   for (int l = m->th_off[k]; l < m->th_off[k + 1]; l++) {
     if (!cand[l]) continue;
-    memcpy(f, it->ftot, (size_t)nx * sizeof(double));
-    for (int q = m->th_off[k]; q < m->th_off[k + 1]; q++)
-      if (th[q] != 0.0) fesd__F_axpy(m, pe, q, -th[q], f);
+    memcpy(f, rest, (size_t)nx * sizeof(double));
     fesd__F_axpy(m, pe, l, 1.0, f);
-    int ok = 1;
-    for (int c = m->th_off[k]; c < m->th_off[k + 1] && ok; c++) {
-      if (c == l || !cand[c]) continue;
-      ok = fesd__dg_dot(m, pe, c, f) - fesd__dg_dot(m, pe, l, f) > 0;
-    }
-    if (ok) pick = l, n_ok++;
+    if (fesd__keeps_alone(m, pe, k, cand, l, f)) pick = l, n_ok++;
   }
   return n_ok == 1 ? pick : -1;
 }

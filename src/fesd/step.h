@@ -26,6 +26,11 @@ void fesd__act_from_theta(const fesd_integrator *it, const double *theta, unsign
 /* Active set at the step start; *nonunique set when x0 lies on a surface that the fields on
  * both sides leave (several Filippov solutions). */
 int fesd__act_start(fesd_integrator *it, const double *u, unsigned char *a, int *nonunique);
+/* Whether mode l of subsystem k keeps itself the strict minimum of g among the candidate modes
+ * cand of k along the total field f (in which l stands alone for k): d/dt (g_c - g_l) > 0 for
+ * every other candidate c, at an evaluated point (a start on a surface, a corner). */
+int fesd__keeps_alone(const fesd__model *m, const fesd__point_eval *pe, int k, const unsigned char *cand, int l,
+                      const double *f);
 int fesd__impose_active(fesd_integrator *it, double *z, const unsigned char *act); /* 1: theta changed */
 /* Border flags of the current layout and rows for the solver (fesd_ncp_set_border). */
 int fesd__set_border(fesd_integrator *it);

@@ -264,12 +264,7 @@ static int scan_filippov(fesd_integrator *it, const double *z, const unsigned ch
   for (int n = 0; n < S->N; n++) {
     const double h = z[S->ho[n]];
     const unsigned char *a = act + (size_t)(n * s) * nth;
-    int any = 0;
-    for (int k = 0; k < m->nsys && !any; k++) {
-      int j;
-      any = fesd__two_modes(&it->model, a, k, &j) >= 0;
-    }
-    if (any) {
+    if (fesd__any_two_modes(m, a)) {
       for (int q = 0; q < s; q++) {
         if (S->tab.c[q] == 0.0 && n > 0) continue; /* the element start: checked before */
         double *X = it->gbuf + nth;

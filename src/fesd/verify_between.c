@@ -135,7 +135,7 @@ int fesd__scan_start(fesd_integrator *it, const double *z, const unsigned char *
 int fesd__scan_switch_points(fesd_integrator *it, const double *z, const unsigned char *act, fesd__violation *ps) {
   fesd__system *S = &it->sys;
   fesd__model *m = &it->model;
-  const int nth = S->nth, s = S->s, exits = S->tab.c[s - 1] == 1.0;
+  const int nth = S->nth, s = S->s, exits = S->tab.c_end_is_one;
   fesd__point_eval pe;
   double tb = 0;
   for (int n = 1; n < S->N; n++) {
@@ -193,11 +193,7 @@ int fesd__scan_interior(fesd_integrator *it, const double *z, const unsigned cha
   for (int n = 0; n < S->N; n++) {
     const double h = z[S->ho[n]];
     const unsigned char *a = act + (size_t)(n * s) * nth;
-    int sliding = 0;
-    for (int k = 0; k < m->nsys && !sliding; k++) {
-      int j;
-      sliding = fesd__two_modes(&it->model, a, k, &j) >= 0;
-    }
+    const int sliding = fesd__any_two_modes(m, a);
     poly_states(it, z, n, it->mid_w, it->n_mid, xm);
     for (int p = 0; p < it->n_mid; p++) {
       const double *x = xm + (size_t)p * S->nx;

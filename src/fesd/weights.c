@@ -146,11 +146,11 @@ int fesd__system_weights(fesd__system *S, const double *z) {
    * pass settles (measured: FESD_ERR_STEP_FAILED on every such step, 331 Newton iterations). */
   double gX = 0, gV = 0;
   for (int r = 0; r < nx; r++) {
-    gX = amax(gX, amax(S->refX[r], T * mf[r]));
+    S->motX[r] = amax(S->refX[r], T * mf[r]);
+    gX = amax(gX, S->motX[r]);
     gV = amax(gV, amax(S->refV[r], mf[r]));
   }
   for (int r = 0; r < nx; r++) {
-    S->motX[r] = amax(S->refX[r], T * mf[r]);
     fX[r] = amax(amax(ATOL_REL * S->motX[r], DBL_EPSILON * gX), FLOOR);
     fV[r] = amax(amax(ATOL_REL * amax(S->refV[r], mf[r]), DBL_EPSILON * gV), FLOOR);
   }

@@ -350,6 +350,25 @@ static int iterate(fesd_ocp *o, int warm) {
   }
 }
 
+/* The SQP's start at the guess wg (a guess still pending is simulated, into wg too), with the
+ * multipliers y0 (NULL: zero). */
+static int start_at_guess(fesd_ocp *o, const double *y0) {
+  const int m = o->mE + o->mI;
+  memcpy(o->cur->w, o->wg, (size_t)o->nw * sizeof(double));
+  if (y0) memcpy(o->y, y0, (size_t)m * sizeof(double));
+  else memset(o->y, 0, (size_t)m * sizeof(double));
+  const int st = o->guess_pending ? fesd__ocp_eval_guess(o, o->cur) : fesd__ocp_eval(o, o->cur);
+  if (o->guess_pending) memcpy(o->wg, o->cur->w, (size_t)o->nw * sizeof(double)); /* the simulated guess */
+  return st;
+}
+
+/* A run of the SQP from the current point, with fresh Hessian approximations. */
+static int run(fesd_ocp *o, int warm) {
+  fesd__ocp_hessian_reset(o);
+  fesd__ocp_sr1_reset(o);
+  return iterate(o, warm);
+}
+
 int fesd_ocp_solve(fesd_ocp *o, fesd_ocp_info *info) {
   if (!o) return FESD_ERR_NULL;
   const double t0 = fesd__thread_cpu_time();
@@ -368,12 +387,7 @@ int fesd_ocp_solve(fesd_ocp *o, fesd_ocp_info *info) {
     pre = !st;
     if (st && st != FESD_ERR_NOMEM) st = FESD_OK; /* its point cannot be evaluated: from the guess */
   }
-  if (!pre) {
-    memcpy(o->cur->w, o->wg, (size_t)o->nw * sizeof(double));
-    memcpy(o->y, o->y_best, (size_t)m * sizeof(double)); /* zero unless warm */
-    if (!st) st = o->guess_pending ? fesd__ocp_eval_guess(o, o->cur) : fesd__ocp_eval(o, o->cur);
-    if (o->guess_pending) memcpy(o->wg, o->cur->w, (size_t)o->nw * sizeof(double)); /* the simulated guess */
-  }
+  if (!pre && !st) st = start_at_guess(o, o->y_best); /* y_best: zero unless warm */
   o->info.presolve_used = pre;
   const int pending = o->guess_pending;
   o->guess_pending = 0;
@@ -381,32 +395,22 @@ int fesd_ocp_solve(fesd_ocp *o, fesd_ocp_info *info) {
   o->best_score = INFINITY;
   memset(&o->best_info, 0, sizeof(o->best_info));
   memcpy(o->w_best, o->cur->w, (size_t)o->nw * sizeof(double));
-  if (!st) {
-    fesd__ocp_hessian_reset(o);
-    fesd__ocp_sr1_reset(o);
-    st = iterate(o, o->warm || pre);
-  }
+  if (!st) st = run(o, o->warm || pre);
   /* The presolve's point can be worse than the guess (measured: a relay oscillator, 3 crossings
    * per interval, T = 4, N = 8: LINE_SEARCH at iteration 0 from it, objective 250 and
    * infeasibility 2.1, where the guess converges to 23.763): a solve that fails from it at once
-   * is repeated from the guess; the better best iterate of the two is returned. */
-  /* only a start the SQP could not move from (within 2 iterations): a solve that fails later
-   * (the stall rule at a nonsmooth point) would fail again from the guess, at twice the cost
-   * (measured: ocp_step_eq, Radau IIA s = 1: 0.55-1.6 s instead of 0.2-0.3 s) */
+   * (within 2 iterations) is repeated from the guess, and the better best iterate of the two is
+   * returned. Not one that fails later (the stall rule at a nonsmooth point): it would fail again
+   * from the guess, at twice the cost (ocp_step_eq, Radau IIA s = 1: 0.55-1.6 s, not 0.2-0.3). */
   if (pre && st != FESD_OK && st != FESD_ERR_NOMEM && !o->warm && o->info.iterations <= 2) {
     const int st_pre = st;
     say(o, "from the presolve: %s; again from the guess", fesd_status_name(st));
-    memcpy(o->cur->w, o->wg, (size_t)o->nw * sizeof(double));
-    memset(o->y, 0, (size_t)m * sizeof(double));
     o->guess_pending = pending;
-    st = o->guess_pending ? fesd__ocp_eval_guess(o, o->cur) : fesd__ocp_eval(o, o->cur);
-    if (o->guess_pending) memcpy(o->wg, o->cur->w, (size_t)o->nw * sizeof(double));
+    st = start_at_guess(o, NULL);
     o->guess_pending = 0;
     if (!st) {
-      fesd__ocp_hessian_reset(o);
-      fesd__ocp_sr1_reset(o);
       const double best = o->best_score;
-      st = iterate(o, 0);
+      st = run(o, 0);
       o->info.presolve_used = o->best_score < best ? 0 : 1;
       if (o->info.presolve_used) st = st_pre; /* the status of the run whose iterate is returned */
     } else if (st != FESD_ERR_NOMEM) {
