@@ -223,6 +223,21 @@ static int element_modes(const fesd_integrator *it, const double *z, int n, int 
   return c;
 }
 
+/* For implicit Euler: the modes of element n (c of them in out) and the one whose exit is
+ * pinned at its end, whose theta is zero at the only stage (the sliding phase showed one element
+ * short, or not at all). */
+static int euler_exit(const fesd_integrator *it, int n, int k, int *out, int c) {
+  const int a = it->model.th_off[k], x = it->exit_mode[n + 1] - a;
+  if (!it->tab.c_end_is_one || it->bmode[n + 1] != 2 || x < 0 || x >= it->model.th_off[k + 1] - a) return c;
+  int p = 0; /* into the ascending list, once */
+  while (p < c && out[p] < x) p++;
+  if (p < c && out[p] == x) return c;
+  memmove(out + p + 1, out + p, (size_t)(c - p) * sizeof(int));
+  out[p] = x;
+  return c + 1;
+}
+
+
 /* Room for need events (doubling; at acceptance, outside the Newton loop: a step with more
  * switches than any before). A step records at most nsys events per element boundary and at
  * its end, and a large scene can switch thousands of times in one step (stick-slip chain,
@@ -404,7 +419,10 @@ int fesd__accept(fesd_integrator *it, const double *z, const double *u, double T
       if (n == 0 && !it->have_prev_theta && !it->start_jumped) continue;
       int nb = n > 0 ? element_modes(it, z, n - 1, k, b)
                : it->have_prev_theta ? active_modes(it, it->theta_prev, k, b) : flagged_modes(it, it->act_first, k, b);
-      add_event(it, t, k, b, nb, element_modes(it, z, n, k, b + nb));
+      if (n > 0 && s == 1) nb = euler_exit(it, n - 1, k, b, nb);
+      int na = element_modes(it, z, n, k, b + nb);
+      if (s == 1) na = euler_exit(it, n, k, b + nb, na);
+      add_event(it, t, k, b, nb, na);
     }
     t += z[S->ho[n]];
   }

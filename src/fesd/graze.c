@@ -45,9 +45,7 @@ int fesd__graze_rates(fesd_integrator *it, const double *u, double *lam, double 
   return FESD_OK;
 }
 
-/* Least value of the cubic Hermite interpolant on [0, 1] of p(0) = a, p(1) = b, p'(0) = da,
- * p'(1) = db, and where it lies (*tau). */
-static double hermite_min(double a, double b, double da, double db, double *tau) {
+double fesd__hermite_min(double a, double b, double da, double db, double *tau) {
   /* p = a + da t + c2 t^2 + c3 t^3 */
   const double c3 = 2 * (a - b) + da + db, c2 = 3 * (b - a) - 2 * da - db;
   double best = fmin(a, b), tb = a < b ? 0.0 : 1.0;
@@ -73,6 +71,17 @@ static double hermite_min(double a, double b, double da, double db, double *tau)
   return best;
 }
 
+double fesd__hermite_first_zero(double a, double b, double da, double db, double tau) {
+  const double c3 = 2 * (a - b) + da + db, c2 = 3 * (b - a) - 2 * da - db;
+  double lo = 0, hi = tau; /* p(lo) > 0 >= p(hi) */
+  for (int i = 0; i < 60 && hi - lo > 1e-15; i++) {
+    const double t = 0.5 * (lo + hi), p = a + t * (da + t * (c2 + t * c3));
+    if (p > 0) lo = t;
+    else hi = t;
+  }
+  return hi;
+}
+
 /* A dip of some inactive mode below its surface inside the last step of length hh (lam_a,
  * rate_a at its start, lam_b, rate_b at its end, in g's units): the earliest one's time from
  * the step start, 0 when none. Subsystems that switched in the step are left to the step's own
@@ -95,7 +104,7 @@ double fesd__graze_dip(const fesd_integrator *it, double hh, const double *lam_a
       const double w = it->sys.wth[i];
       if (!(lam_a[i] * w > 1e-9 && lam_b[i] * w > 1e-9 && rate_a[i] < 0 && rate_b[i] > 0)) continue;
       double tau;
-      const double p = hermite_min(lam_a[i], lam_b[i], hh * rate_a[i], hh * rate_b[i], &tau);
+      const double p = fesd__hermite_min(lam_a[i], lam_b[i], hh * rate_a[i], hh * rate_b[i], &tau);
       if (p < 0 && (t_dip == 0 || tau * hh < t_dip)) t_dip = tau * hh;
     }
   }

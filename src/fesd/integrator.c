@@ -201,12 +201,14 @@ static void lay_out(fesd_integrator *it, const fesd_settings *settings, fesd__bl
   it->rk_act = fesd__block_take(B, N * s * nth, 0);
   it->rk_bmode = fesd__block_take(B, (2 * (N + 1)) * sizeof(int), 1); /* bmode, then exit_mode */
   it->jump_in = fesd__block_take(B, nsys * sizeof(int), 0);
+  it->stop_dir = fesd__block_take(B, nsys, 0);
   it->jump_out = fesd__block_take(B, nsys * sizeof(int), 0);
   it->scan_buf = fesd__block_take(B, nsys * sizeof(*it->scan_buf), 0);
   it->plan = fesd__block_take(B, cp * sizeof(*it->plan), 0);
   it->plan_after = fesd__block_take(B, cp * nth, 0);
   it->bseg = fesd__block_take(B, (cp + 2) * sizeof(int), 0);
   it->fil_th = fesd__block_doubles(B, nth);
+  it->herm = fesd__block_doubles(B, 2 * nth);
   it->slide_tmp = fesd__block_doubles(B, 2 * nx);
   it->fil_a = fesd__block_take(B, nth, 0);
   fesd__point_take(&it->model, &it->pscr, 1, B);
@@ -361,11 +363,8 @@ int fesd_set_state(fesd_integrator *it, double t0, const double *x0, const doubl
   it->n_events = 0;
   it->h_next = 0;
   it->log_n = 0;
-  it->stop_sys = -1;
-  it->stop_t = NAN;
+  memset(it->stop_dir, 0, (size_t)it->nsys);
   it->ap_t = NAN;
-  it->stop_up = 0;
-  it->stop_h = 0;
   it->ec_rejected = 0;
   it->ec_err_prev = 0;
   it->log_pool_n = 0;

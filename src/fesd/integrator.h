@@ -104,6 +104,7 @@ struct fesd_integrator {
   int gn_full_at; /* the Newton pass that converged last (evaluated in full: stage_newton.c) */
   int gn_warm;    /* the warm start solved the last element as it was: check it first */
   double *fil_th;         /* nth: multipliers of an alternative (verify.c) */
+  double *herm;           /* 2 nth: distance and rate of each mode at an element start (verify_between.c) */
   double *slide_tmp;      /* 2 nx: the coupled sliding multipliers (fesd__stage_theta) */
   unsigned char *fil_a;   /* nth: its active flags */
   int *gn_piv;
@@ -175,10 +176,9 @@ struct fesd_integrator {
   int log_n, log_cap;
   int ec_rejected;     /* error control: the last step attempt was rejected (no growth) */
   double ec_err_prev;  /* ... and the last accepted error estimate (PI control; 0: none) */
-  int stop_sys;      /* the stop condition the last fesd_integrate stopped on (-1: none) */
-  double stop_t;     /* ... and when (its crossing at the next step start is not logged again) */
-  int stop_up;       /* ... its direction (1: increasing) */
-  double stop_h;     /* ... and the length of the step that ended on it */
+  signed char *stop_dir; /* per stop condition: the direction of its last stop (1 increasing,
+                            -1 decreasing) until it crosses back, 0 then: its crossings in that
+                            direction meanwhile are that stop (integrate.c, same_stop) */
   size_t log_pool_n, log_pool_cap;
   fesd_event *events; /* the last step's events: room for ev_max (accept.c grows it) */
   int n_events, ev_max;
@@ -211,6 +211,11 @@ void fesd__load(fesd_integrator *it, const fesd__saved *b);
 int fesd__use_level(fesd_integrator *it, int N);
 /* The element count of the ladder that holds at least N elements (at most N_cap). */
 int fesd__ladder(const fesd_integrator *it, int N);
+/* Least value of the cubic Hermite interpolant on [0, 1] of p(0) = a, p(1) = b, p'(0) = da,
+ * p'(1) = db, and where it lies (*tau); the first zero before tau of one with a > 0 >= p(tau)
+ * (bisection to round-off). */
+double fesd__hermite_min(double a, double b, double da, double db, double *tau);
+double fesd__hermite_first_zero(double a, double b, double da, double db, double tau);
 /* Graze check of an error-controlled step (graze.c). */
 int fesd__graze_rates(fesd_integrator *it, const double *u, double *lam, double *rate);
 double fesd__graze_dip(const fesd_integrator *it, double hh, const double *lam_a, const double *rate_a,

@@ -36,7 +36,7 @@ void fesd__plan_reset(fesd_integrator *it) {
   memset(it->plan_sig, 0, sizeof it->plan_sig);
 }
 
-static unsigned char *after(fesd_integrator *it, int e) { return it->plan_after + (size_t)e * it->nth; }
+static unsigned char *after(fesd_integrator *it, int e) { return fesd__plan_after(it, e); }
 
 static void swap_switch(fesd_integrator *it, int a, int b) {
   fesd__switch t = it->plan[a];
@@ -67,119 +67,6 @@ void fesd__plan_truncate(fesd_integrator *it, double t) {
 void fesd__plan_sort(fesd_integrator *it) {
   for (int a = 1; a < it->n_plan; a++)
     for (int b = a; b > 0 && it->plan[b].t < it->plan[b - 1].t; b--) swap_switch(it, b, b - 1);
-}
-
-/* Boundaries of the sorted plan: clusters of entering switches of different subsystems within
- * merge_tol T share one; an exit has its own. Writes bt[1..nb] and returns nb. */
-static int cluster(fesd_integrator *it, double T, int *first_of) {
-  int nb = 0;
-  for (int e = 0; e < it->n_plan; e++) {
-    const fesd__switch *w = &it->plan[e];
-    int join = 0;
-    if (nb > 0 && !w->exit) {
-      const int f = first_of[nb - 1];
-      join = !it->plan[f].exit && w->t - it->plan[f].t <= it->merge_tol * T;
-      for (int q = f; q < e && join; q++) join = it->plan[q].sys != w->sys && !it->plan[q].exit;
-    }
-    if (!join) {
-      first_of[nb] = e;
-      it->bt[++nb] = w->t;
-    }
-    it->plan[e].kb = nb; /* cluster index for now; element boundary below */
-  }
-  return nb;
-}
-
-int fesd__plan_layout(fesd_integrator *it, double T, double *z) {
-  fesd__system *S = &it->sys;
-  const int nth = it->nth, s = it->s;
-  fesd__plan_sort(it);
-  int *first_of = it->kb;
-  const int nb = cluster(it, T, first_of);
-  if (nb + 1 > it->N_cap) return FESD_ERR_TOO_MANY_SWITCHES;
-  /* boundary times strictly increasing inside (0, T) */
-  double *bt = it->bt;
-  const double gap = 1e-8 * T;
-  bt[0] = 0;
-  bt[nb + 1] = T;
-  for (int q = 1; q <= nb; q++) {
-    if (bt[q] < bt[q - 1] + gap) bt[q] = bt[q - 1] + gap;
-    if (bt[q] > T - (nb + 1 - q) * gap) bt[q] = T - (nb + 1 - q) * gap;
-  }
-  /* After a failed solve (split_layout): no element longer than the nominal T / N_FE where
-   * the cap allows, a switch splits an element instead of stretching its neighbour. With
-   * N_FE = 2 one early switch leaves a single element of almost T after it, where the
-   * fixed-active-set Newton of a coupled chain did not converge (stick-slip chain, n = 64:
-   * 40 Newton iterations in such a step, 8 with the split). Not the default: it costs an
-   * element per switch step and a workspace level more. */
-  int want = nb + 1 > it->set.n_fe ? nb + 1 : it->set.n_fe;
-  if (it->split_layout) {
-    const double h_nom = T / (it->set.n_fe * (double)(1 << (it->split_layout - 1)));
-    int split = 0;
-    for (int q = 0; q <= nb; q++) {
-      const int c = (int)ceil((bt[q + 1] - bt[q]) / h_nom - 1e-6);
-      split += c > 1 ? c : 1;
-    }
-    if (split > want && split <= it->N_cap) want = split;
-  }
-  const int N = fesd__ladder(it, want);
-  int st = fesd__use_level(it, N);
-  if (st) return st;
-  /* elements per segment: one each, the rest to the segment with the longest elements */
-  int *cnt = it->bseg;
-  for (int q = 0; q <= nb; q++) cnt[q] = 1;
-  for (int extra = N - (nb + 1); extra > 0; extra--) {
-    int best = 0;
-    for (int q = 1; q <= nb; q++)
-      if ((bt[q + 1] - bt[q]) * cnt[best] > (bt[best + 1] - bt[best]) * cnt[q]) best = q;
-    cnt[best]++;
-  }
-  /* bounds of the element lengths: a fresh switch stays in its bracket, the others move
-   * freely (bt_lo/bt_hi: bounds of the boundary times) */
-  {
-    double lo_prev = 0, hi_prev = 0;
-    int e = 0;
-    for (int q = 0; q <= nb; q++) {
-      double lo_next = T, hi_next = T;
-      if (q < nb) {
-        lo_next = 0, hi_next = T;
-        for (; e < it->n_plan && it->plan[e].kb == q + 1; e++)
-          if (it->plan[e].fresh) {
-            lo_next = lo_next > it->plan[e].lo ? lo_next : it->plan[e].lo;
-            hi_next = hi_next < it->plan[e].hi ? hi_next : it->plan[e].hi;
-          }
-        if (!(lo_next < hi_next)) lo_next = 0, hi_next = T;
-      }
-      double lo = (lo_next - hi_prev) / cnt[q], hi = (hi_next - lo_prev) / cnt[q];
-      it->bseg_lo[q] = lo > 1e-9 * T ? lo : 1e-9 * T;
-      it->bseg_hi[q] = hi < T ? hi : T;
-      lo_prev = lo_next, hi_prev = hi_next;
-    }
-  }
-  /* active sets, boundary rows and element lengths */
-  unsigned char *cur = it->cand;
-  memcpy(cur, it->act0, (size_t)nth);
-  memset(it->bmode, 0, (size_t)(N + 1) * sizeof(int));
-  int n = 0, e = 0;
-  for (int q = 0; q <= nb; q++) {
-    if (q > 0) {
-      for (; e < it->n_plan && it->plan[e].kb == q; e++) {
-        fesd__switch *w = &it->plan[e];
-        const int a = it->model.th_off[w->sys], b = it->model.th_off[w->sys + 1];
-        memcpy(cur + a, after(it, e) + a, (size_t)(b - a));
-        it->bmode[n] = w->exit ? 2 : 1;
-        it->exit_mode[n] = w->mode;
-        w->kb = n;
-      }
-    }
-    for (int c = 0; c < cnt[q]; c++, n++) {
-      for (int j = 0; j < s; j++) memcpy(it->act + (size_t)(n * s + j) * nth, cur, (size_t)nth);
-      z[S->ho[n]] = (bt[q + 1] - bt[q]) / cnt[q];
-      it->hlo[n] = it->bseg_lo[q];
-      it->hhi[n] = it->bseg_hi[q];
-    }
-  }
-  return FESD_OK;
 }
 
 void fesd__plan_times(fesd_integrator *it, const double *z) {
@@ -413,6 +300,34 @@ static int update_one(fesd_integrator *it, const double *z, const fesd__violatio
   unsigned char *ns = it->cand; /* new set of subsystem k (slice a..b used) */
   int e;
   const unsigned char *P = set_before(it, k, v->t, &e);
+  fesd__violation later;
+  if (v->filippov > 0 && can_pin_exit(it)) {
+    /* Filippov's conditions fail at a point after the step start (or after the sliding entry
+     * before it) where they held: the sliding mode ends in between, an exit of the mode that
+     * does not continue, not a crossing from the start (or from that entry). Measured: a stuck
+     * phase of a forced stick-slip oscillator under error control whose slip began between a
+     * stage and a midpoint: the start jumped to slipping, whose own start then violated the
+     * stick condition, and the plan cycled. */
+    const double t_a = e < 0 ? 0.0 : it->plan[e].t;
+    int stands = 0;
+    if (v->t > t_a + AT_START * T && (e < 0 || !it->plan[e].exit)) {
+      const unsigned char *A = e < 0 ? it->act : it->act + (size_t)it->plan[e].kb * it->sys.s * it->nth;
+      int st = fesd__sliding_stands(it, z, t_a, A, k, &stands);
+      if (st) return st;
+    }
+    if (stands) {
+      int j, i = fesd__two_modes(&it->model, P, k, &j);
+      later = *v;
+      later.filippov = 0;
+      later.enter = 0;
+      later.first = 0;
+      later.mode = i == v->mode ? j : i;
+      later.lo = t_a;
+      later.hi = v->t;
+      later.t = 0.5 * (t_a + v->t);
+      v = &later;
+    }
+  }
   if (v->filippov) {
     /* not a sliding mode: the mode whose field points into its own region continues */
     if (v->filippov < 0) it->nonunique = 1;
@@ -429,6 +344,25 @@ static int update_one(fesd_integrator *it, const double *z, const fesd__violatio
     drop_after(it, k, it->plan[e].t);
     remove_if_unchanged(it, e);
     return 1;
+  }
+  if (v->first && e >= 0 && !v->enter && it->sys.s == 1 && it->tab.c_end_is_one && !it->plan[e].exit) {
+    /* With one stage per element the first point checked after a sliding entry is the end of
+     * the element that follows it, possibly far from the entry: when Filippov's conditions hold
+     * at the entry itself, the entry stands and the mode leaves later (measured: ocp_step_eq's
+     * dynamics, implicit Euler, a start 1e-4 above c1 = 0 sliding until 0.198 of a step of
+     * 0.67: the exit was taken for a wrong entry, the plan cycled, and the finer layout it fell
+     * back to gave another solution than a start on the surface: the step map jumped) */
+    int stands;
+    const unsigned char *A = it->act + (size_t)it->plan[e].kb * it->sys.s * it->nth;
+    int st = fesd__sliding_stands(it, z, it->plan[e].t, A, k, &stands);
+    if (st) return st;
+    if (stands) {
+      later = *v;
+      later.first = 0;
+      later.lo = fmax(v->lo, it->plan[e].t);
+      if (!(later.t > later.lo && later.t < later.hi)) later.t = 0.5 * (later.lo + later.hi);
+      v = &later;
+    }
   }
   if (v->first && e >= 0) {
     /* the switch before chose the wrong modes: add the mode that wants in, drop the one

@@ -77,6 +77,11 @@ int fesd__scan_switch_points(fesd_integrator *it, const double *z, const unsigne
 /* A start within round-off of a surface that its field reaches at once: an entry at that time. */
 int fesd__scan_start(fesd_integrator *it, const double *z, const unsigned char *act, fesd__violation *ps);
 int fesd__scan_interior(fesd_integrator *it, const double *z, const unsigned char *act, fesd__violation *ps);
+/* One-stage methods: an excursion into another mode's region between the two ends of an
+ * element (cubic Hermite interpolant of the distance to the surface and its rate). */
+int fesd__scan_hermite(fesd_integrator *it, const double *z, const unsigned char *act, fesd__violation *ps);
+/* Whether subsystem k's 2-mode sliding in the sets a holds Filippov's conditions at time t of z. */
+int fesd__sliding_stands(fesd_integrator *it, const double *z, double t, const unsigned char *a, int k, int *out);
 /* Interpolant of element n of z at the weights w (collocation polynomial, fesd__colloc_weights,
  * or the interior-check weights of Lobatto IIIC). */
 void fesd__poly_state(const fesd_integrator *it, const double *z, int n, const double *w, double *x);
@@ -116,6 +121,10 @@ int fesd__resort_guess(fesd_integrator *it, const double *zsrc, double T, const 
 void fesd__plan_reset(fesd_integrator *it);
 /* The plan sorted by time; switch e removed (plan.c). */
 void fesd__plan_sort(fesd_integrator *it);
+/* The active set after switch e of the plan (all subsystems). */
+static inline unsigned char *fesd__plan_after(fesd_integrator *it, int e) {
+  return it->plan_after + (size_t)e * it->nth;
+}
 void fesd__plan_remove(fesd_integrator *it, int e);
 /* Element layout of the plan for a (sub)step of length T: boundaries, element count (a level of
  * the ladder), per-stage active sets, boundary rows and element lengths (written into z).

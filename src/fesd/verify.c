@@ -309,6 +309,7 @@ int fesd__scan(fesd_integrator *it, const double *z, const unsigned char *act, i
     if (!st && !it->sys.tab.is_explicit) st = fesd__scan_switch_points(it, z, act, ps);
     if (!st && !it->sys.tab.is_explicit) st = fesd__scan_start(it, z, act, ps);
     if (!st && it->n_mid > 0) st = fesd__scan_interior(it, z, act, ps);
+    if (!st && it->sys.s == 1 && it->sys.tab.c_end_is_one) st = fesd__scan_hermite(it, z, act, ps);
   }
   memset(v, 0, sizeof(*v));
   for (int k = 0; k < K; k++)

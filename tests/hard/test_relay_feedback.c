@@ -15,7 +15,14 @@
  * 17 entries) come in the reference's kind and order, and the event-time and end-state
  * errors converge with order >= 2s - 1.5 (least-squares slopes over the aligned runs).
  * And error-controlled (fesd_integrate, Radau IIA s = 3, rtol 1e-5, 1e-8, 1e-11, atol =
- * 1e-3 rtol): the reference's 34 events, x(T) within 10 rtol of the largest component. */
+ * 1e-3 rtol): the reference's 34 events, x(T) within 10 rtol of the largest component.
+ * Stop conditions r = x_i + c (i = 2, 3, seeded random levels, either direction) through
+ * fesd_integrate, restarted after every FESD_ROOT (Radau IIA s = 3, Lobatto IIIC s = 4, rtol
+ * 1e-4 .. 1e-10): as many stops as the reference flow crosses the level in that direction (no
+ * stop twice for one crossing: slow crossings near an extremum of x_i are located to ~1e-5
+ * only, and a window of 1e-6 step lengths took the next step's sight of the same crossing for
+ * a new one), each within 1e-3 of its crossing, and the event log holding each stop once (the
+ * step re-solved to end on the root also logged the crossing it found inside itself). */
 #include "hard_util.h"
 
 #define NY 4 /* x1, x2, x3, 1 */
@@ -147,6 +154,100 @@ static void reference_state(const reference *R, double t, double *x) {
   double y[NY];
   flow(R->mode[p], t - R->t[p], R->y[p], y);
   memcpy(x, y, 3 * sizeof(double));
+}
+
+/* ---- stop conditions r = x_i + c ---- */
+typedef struct {
+  int i;
+  double c;
+} level;
+static int level_root(double t, const double *x, const double *u, double *r, void *user) {
+  (void)t, (void)u;
+  const level *L = user;
+  r[0] = x[L->i] + L->c;
+  return 0;
+}
+/* crossings of the reference flow through the level in direction dir (+1 increasing) */
+static int level_crossings(const reference *R, const level *L, int dir, double *tc, int max) {
+  int n = 0;
+  double x[3], ta = 0, ra;
+  reference_state(R, ta, x);
+  ra = x[L->i] + L->c;
+  for (double tb = 1e-4; tb <= T && n < max; tb += 1e-4) {
+    reference_state(R, tb, x);
+    const double rb = x[L->i] + L->c;
+    if ((ra < 0) != (rb < 0) && (rb > ra) == (dir > 0)) {
+      double lo = ta, hi = tb;
+      for (int it = 0; it < 60; it++) {
+        const double mid = 0.5 * (lo + hi);
+        reference_state(R, mid, x);
+        if ((x[L->i] + L->c < 0) == (ra < 0)) lo = mid;
+        else hi = mid;
+      }
+      tc[n++] = 0.5 * (lo + hi);
+    }
+    ta = tb, ra = rb;
+  }
+  return n;
+}
+
+static int stop_runs(const reference *R, const double *x0) {
+  int fails = 0, runs = 0, right = 0, stops = 0;
+  const int nm[1] = {2}, ns[1] = {1};
+  const struct {
+    fesd_rk_family fam;
+    int s;
+  } meth[] = {{FESD_RK_RADAU_IIA, 3}, {FESD_RK_LOBATTO_IIIC, 4}};
+  unsigned long long seed = 20261128ULL;
+  for (int q = 0; q < 8; q++) {
+    seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+    level L = {1 + q % 2, 0};
+    L.c = (q % 2 ? 2.0 : 0.9) * (2.0 * (double)(seed >> 11) * 0x1.0p-53 - 1.0); /* x2 in (-1, 1), x3 in (-2, 2) */
+    for (int dir = -1; dir <= 1; dir += 2) {
+      double tc[64];
+      const int nc = level_crossings(R, &L, dir, tc, 64);
+      const int rd[1] = {dir};
+      fesd_model m = {.nx = 3, .nsys = 1, .n_modes = nm, .n_switch = ns, .field = field, .field_jac = field_jac,
+                      .sw = sw, .sw_jac = sw_jac, .n_roots = 1, .roots = level_root, .root_dir = rd, .user = &L};
+      for (unsigned mi = 0; mi < sizeof meth / sizeof *meth; mi++)
+        for (double rtol = 1e-4; rtol >= 1e-10; rtol *= 1e-3) {
+          fesd_settings set;
+          fesd_settings_default(&set);
+          set.family = meth[mi].fam, set.stages = meth[mi].s;
+          fesd_integrator *it;
+          if (fesd_create(&it, &m, &set)) return fails + 1;
+          fesd_tolerances tol;
+          fesd_tolerances_default(&tol);
+          tol.rtol = rtol, tol.atol = 1e-3 * rtol;
+          fesd_set_tolerances(it, &tol);
+          fesd_set_state(it, 0.0, x0, NULL);
+          int st, n_stop = 0, on_time = 1;
+          fesd_integrate_info info;
+          while ((st = fesd_integrate(it, NULL, T, &info)) == FESD_ROOT) {
+            double t;
+            fesd_get_state(it, &t, NULL);
+            on_time &= n_stop < nc && fabs(t - tc[n_stop]) <= 1e-3;
+            n_stop++;
+          }
+          const fesd_event *ev;
+          int ne, n_log = 0;
+          fesd_event_log(it, &ev, &ne);
+          for (int e = 0; e < ne; e++) n_log += ev[e].kind == FESD_EVENT_ROOT;
+          runs++, stops += n_stop;
+          const int ok = st == FESD_OK && n_stop == nc && n_log == n_stop && on_time;
+          right += ok;
+          if (!ok)
+            printf("  stop x%d %+.4f dir %+d, %s s=%d rtol %.0e: %s, %d stops, %d in the log, %d crossings%s\n",
+                   L.i + 1, L.c, dir, fesd_rk_family_name(set.family), set.stages, rtol, fesd_status_name(st), n_stop,
+                   n_log, nc, on_time ? "" : ", stop times off");
+          fesd_free(&it);
+        }
+    }
+  }
+  printf("relay feedback, stop conditions x_i + c through fesd_integrate: %d runs, %d right, %d stops\n", runs, right,
+         stops);
+  HD_CHECK(right == runs, "%d of %d stop runs wrong", runs - right, runs);
+  return fails;
 }
 
 /* ---- independent check: RK4 on the Filippov field, sliding = convex combination ---- */
@@ -328,6 +429,7 @@ int main(void) {
     HD_CHECK(st == FESD_OK && a == 0 && ex <= 10 * rtol, "fesd_integrate rtol %.0e: %s, alignment %d, x(T) %.1e", rtol,
              fesd_status_name(st), a, ex);
   }
+  fails += stop_runs(&R, x0);
   printf("%d failures\n", fails);
   return fails != 0;
 }

@@ -1,6 +1,6 @@
 /* The no-progress rule (settings.stall_window) on ocp_step_eq with FESD Radau IIA s = 1,
- * N_FE = 2, no presolve: the step map of interval 3 jumps at the iterates (node x_3 at the
- * co-dimension-2 sliding point), so the SQP only creeps. (Until the start-near-surface fix of
+ * N_FE = 2, no presolve: the step map of interval 2 bends near the iterates (its trajectory
+ * slides into the co-dimension-2 point, node x_3), so the SQP only creeps. (Until the start-near-surface fix of
  * the integrator this test used Lobatto IIIC s = 2, which now converges.) Checks: the bounded failure (status, counts), that the returned iterate is a logged
  * one with the reported residuals and satisfies the dynamics to the reported feasibility
  * (independent re-simulation), Gauss-Newton stopping after one window, the range check, and a
@@ -74,12 +74,13 @@ static double defect(const fesd_problem *P, const fesd_settings *is, const doubl
 
 /* max over the state directions of |forward - backward difference| of Phi_k at (x_k, u_k),
  * step e, by a fresh integrator: round-off and O(e) where Phi_k is smooth, O(1) or more at a
- * kink, O(1/e) at a jump */
+ * kink, O(1/e) at a jump; *slope: the largest |forward difference| / e of the positions q */
 static double one_sided_gap(const fesd_problem *P, const fesd_settings *is, int k, const double *x, const double *u,
-                            double e) {
+                            double e, double *slope) {
   fesd_integrator *it;
   if (fesd_create(&it, &P->model, is)) return NAN;
   double gap = 0;
+  *slope = 0;
   for (int j = 0; j < 4; j++) {
     double xe[3][4];
     for (int sgn = -1; sgn <= 1; sgn++) {
@@ -89,8 +90,10 @@ static double one_sided_gap(const fesd_problem *P, const fesd_settings *is, int 
       if (fesd_set_state(it, k * 4.0 / N, x0, u + 2 * k) || fesd_step(it, u + 2 * k, 4.0 / N, NULL)) gap = NAN;
       fesd_get_state(it, NULL, xe[sgn + 1]);
     }
-    for (int i = 0; i < 4; i++)
+    for (int i = 0; i < 4; i++) {
       gap = fmax(gap, fabs((xe[2][i] - xe[1][i]) / e - (xe[1][i] - xe[0][i]) / e));
+      if (i < 2) *slope = fmax(*slope, fabs(xe[2][i] - xe[1][i]) / e);
+    }
   }
   fesd_free(&it);
   return gap;
@@ -112,20 +115,22 @@ int main(void) {
          info.feasibility, 1e3 * info.time_total);
   CHECK(st == FESD_ERR_LINE_SEARCH && info.status == st, "status %s", fesd_status_name(st));
   CHECK(info.stalled == 1 && info.hessian_fallback == 1, "stalled %d fallback %d", info.stalled, info.hessian_fallback);
-  /* the rule names the interval k whose switch structure changed at the rejected trials; the
-   * NLP is not smooth at its end node x_{k+1} (the co-dimension-2 sliding point): one-sided
-   * differences of Phi_{k+1} disagree (measured 6.6e5 with e = 1e-7: a jump of 0.066 in Phi_3,
-   * k = 2), those of interval 0 agree (2.2e-9). (Lobatto IIIC s = 2, which stalled here before,
-   * converges since the integrator solves starts within 1e-9 T of the sliding surface without
-   * halving: tests/hard/test_start_near_surface.c.) */
+  /* the rule names the interval k whose switch structure changed at the rejected trials: here
+   * k = 2, which slides into the co-dimension-2 point q = 0 before its end, so that its step map
+   * is constant in q near the iterate (q_3 = that point) and bends where the trajectory stops
+   * reaching the point inside the interval; the full steps (|d| ~ 0.035) cross that bend, the
+   * l1 merit rejects them and the iterates creep. Checked: Phi_k flat in q and smooth near the
+   * iterate (forward differences ~0, one-sided ones agree), interval 0 not flat. (Before the
+   * integrator placed implicit Euler's sliding phases consistently near a surface, Phi_3 jumped
+   * there by 0.066; Lobatto IIIC s = 2, which stalled here before that, converges since starts
+   * within 1e-9 T of the sliding surface are solved without halving.) */
   CHECK(info.stall_interval >= 0 && info.stall_interval < N, "stall_interval %d", info.stall_interval);
   if (info.stall_interval >= 0 && info.stall_interval < N) {
     const int k = info.stall_interval;
-    double g = one_sided_gap(&P, &is, k, x, u, 1e-7);
-    if (k + 1 < N) g = fmax(g, one_sided_gap(&P, &is, k + 1, x, u, 1e-7));
-    const double g0 = one_sided_gap(&P, &is, 0, x, u, 1e-7);
-    printf("  stall_interval %d: one-sided difference gap %.2e at it or the next (interval 0: %.2e)\n", k, g, g0);
-    CHECK(g > 1e3 * g0 && g > 1.0, "gap %.3e at interval %d or %d vs %.3e at interval 0", g, k, k + 1, g0);
+    double sk, s0;
+    const double g = one_sided_gap(&P, &is, k, x, u, 1e-6, &sk), g0 = one_sided_gap(&P, &is, 0, x, u, 1e-6, &s0);
+    printf("  stall_interval %d: slope %.2e, one-sided difference gap %.2e (interval 0: %.2e, %.2e)\n", k, sk, g, s0, g0);
+    CHECK(sk < 1e-6 && g < 1e-6 && s0 > 0.1, "interval %d: slope %.3e gap %.3e; interval 0 slope %.3e", k, sk, g, s0);
   }
   CHECK(info.iterations >= 2 * W && info.iterations <= 2 * W + 20, "iterations %d (before the rule: 200)", info.iterations);
   CHECK(info.integrations < 2000, "integrations %d (before the rule: 16190)", info.integrations);
