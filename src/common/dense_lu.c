@@ -54,3 +54,57 @@ void fesd__dense_lu_solve(int n, const double *a, const int *piv, double *x) {
   }
 }
 
+
+/* Columns x0..x(w-1) (w <= 4) at once: each factor entry is loaded once for all of them, and
+ * each column gets the operations of fesd__dense_lu_solve in its order (bit for bit). Called
+ * with a constant w, so that the compiler drops the unused columns. */
+static inline void solve_w(int n, const double *restrict a, const int *restrict piv, int w, double *restrict x0,
+                           double *restrict x1, double *restrict x2, double *restrict x3) {
+  for (int k = 0; k < n; k++) {
+    const int p = piv[k];
+    if (p == k) continue;
+    double t = x0[k];
+    x0[k] = x0[p], x0[p] = t;
+    if (w > 1) t = x1[k], x1[k] = x1[p], x1[p] = t;
+    if (w > 2) t = x2[k], x2[k] = x2[p], x2[p] = t;
+    if (w > 3) t = x3[k], x3[k] = x3[p], x3[p] = t;
+  }
+  for (int k = 0; k < n; k++) {
+    const double *ck = a + (size_t)k * n, s0 = x0[k], s1 = w > 1 ? x1[k] : 0.0, s2 = w > 2 ? x2[k] : 0.0,
+                 s3 = w > 3 ? x3[k] : 0.0;
+    for (int i = k + 1; i < n; i++) {
+      const double c = ck[i];
+      x0[i] -= c * s0;
+      if (w > 1) x1[i] -= c * s1;
+      if (w > 2) x2[i] -= c * s2;
+      if (w > 3) x3[i] -= c * s3;
+    }
+  }
+  for (int k = n - 1; k >= 0; k--) {
+    const double *ck = a + (size_t)k * n, d = ck[k];
+    const double s0 = x0[k] /= d, s1 = w > 1 ? x1[k] /= d : 0.0, s2 = w > 2 ? x2[k] /= d : 0.0,
+                 s3 = w > 3 ? x3[k] /= d : 0.0;
+    for (int i = 0; i < k; i++) {
+      const double c = ck[i];
+      x0[i] -= c * s0;
+      if (w > 1) x1[i] -= c * s1;
+      if (w > 2) x2[i] -= c * s2;
+      if (w > 3) x3[i] -= c * s3;
+    }
+  }
+}
+
+void fesd__dense_lu_solve_many(int n, const double *a, const int *piv, double *x, int nrhs) {
+  const size_t ld = (size_t)n;
+  for (int j = 0; j < nrhs;) {
+    double *c = x + (size_t)j * ld;
+    const int w = nrhs - j < 4 ? nrhs - j : 4;
+    switch (w) {
+    case 4: solve_w(n, a, piv, 4, c, c + ld, c + 2 * ld, c + 3 * ld); break;
+    case 3: solve_w(n, a, piv, 3, c, c + ld, c + 2 * ld, NULL); break;
+    case 2: solve_w(n, a, piv, 2, c, c + ld, NULL, NULL); break;
+    default: fesd__dense_lu_solve(n, a, piv, c); break;
+    }
+    j += w;
+  }
+}

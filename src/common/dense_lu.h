@@ -8,5 +8,7 @@
 int fesd__dense_lu(int n, double *a, int *piv);
 /* x <- A^{-1} x with the factors of fesd__dense_lu. */
 void fesd__dense_lu_solve(int n, const double *a, const int *piv, double *x);
+/* The same for nrhs columns of x (leading dimension n), each bit for bit as above. */
+void fesd__dense_lu_solve_many(int n, const double *a, const int *piv, double *x, int nrhs);
 
 #endif

@@ -15,6 +15,8 @@
 #ifndef FESD_NCP_LINSOLVE_H
 #define FESD_NCP_LINSOLVE_H
 
+#include <stddef.h>
+
 enum { FESD__LS_LU = 0, FESD__LS_NORMAL = 1 };
 enum { FESD__LAYOUT_DENSE = 0, FESD__LAYOUT_CSC = 1, FESD__LAYOUT_CSC_T = 2 };
 
@@ -32,6 +34,9 @@ typedef struct {
   /* x (n) holds the right-hand side on entry and the solution on return. */
   int (*solve)(fesd__ls *ls, double *x);
   void (*destroy)(fesd__ls *ls);
+  /* Optional (NULL: solve per column): nrhs right-hand sides in x (column-major, leading
+   * dimension n), each solved bit for bit as by solve, with less work per column. */
+  int (*solve_many)(fesd__ls *ls, double *x, int nrhs);
 } fesd__ls_ops;
 
 struct fesd__ls {
@@ -57,6 +62,13 @@ void fesd__ls_border_flags(fesd__ls *ls, const unsigned char *row_border, const 
  * entries; the flags as for the bordered KLU. */
 int fesd__ls_bdense_create(fesd__ls **ls, int n, int max_nz);
 void fesd__ls_bdense_flags(fesd__ls *ls, const unsigned char *row_border, const unsigned char *col_border);
+
+static inline int fesd__ls_solve_many(fesd__ls *ls, double *x, int nrhs) {
+  if (ls->ops->solve_many) return ls->ops->solve_many(ls, x, nrhs);
+  int rc = 0; /* FESD_OK */
+  for (int j = 0; j < nrhs && !rc; j++) rc = ls->ops->solve(ls, x + (size_t)j * ls->n);
+  return rc;
+}
 
 static inline void fesd__ls_destroy(fesd__ls **ls) {
   if (ls && *ls) {

@@ -216,8 +216,75 @@ static int bd_solve(fesd__ls *ls, double *x) {
   return FESD_OK;
 }
 
-static const fesd__ls_ops bdense_ops = {FESD__LS_LU, FESD__LAYOUT_CSC, 0, bd_analyze,
-                                        bd_factor,   bd_solve,         bd_destroy};
+/* y_r[i] -= c[i] s_r for i in [lo, hi) and the w (<= 4) columns y_r: one load of c for all;
+ * inlined with a constant w. */
+static inline void update_w(const double *restrict c, int lo, int hi, int w, const double *s, double *restrict y0,
+                            double *restrict y1, double *restrict y2, double *restrict y3) {
+  const double s0 = s[0], s1 = w > 1 ? s[1] : 0.0, s2 = w > 2 ? s[2] : 0.0, s3 = w > 3 ? s[3] : 0.0;
+  for (int i = lo; i < hi; i++) {
+    const double ci = c[i];
+    y0[i] -= ci * s0;
+    if (w > 1) y1[i] -= ci * s1;
+    if (w > 2) y2[i] -= ci * s2;
+    if (w > 3) y3[i] -= ci * s3;
+  }
+}
+
+/* The update of the columns with a nonzero multiplier s_r, together (a zero one is skipped, as
+ * in bd_solve). */
+static void update(const double *c, int lo, int hi, int w, const double *s, double *const *y) {
+  double *u[4], t[4];
+  int nz = 0;
+  for (int r = 0; r < w; r++)
+    if (s[r] != 0.0) u[nz] = y[r], t[nz++] = s[r];
+  switch (nz) {
+  case 4: update_w(c, lo, hi, 4, t, u[0], u[1], u[2], u[3]); break;
+  case 3: update_w(c, lo, hi, 3, t, u[0], u[1], u[2], NULL); break;
+  case 2: update_w(c, lo, hi, 2, t, u[0], u[1], NULL, NULL); break;
+  case 1: update_w(c, lo, hi, 1, t, u[0], NULL, NULL, NULL); break;
+  default: break;
+  }
+}
+
+/* nrhs columns of x (leading dimension n), up to 4 at a time through b->y, each bit for bit as
+ * by bd_solve (a single one by bd_solve: the block's bookkeeping costs more than it saves). */
+static int bd_solve_many(fesd__ls *ls, double *x, int nrhs) {
+  bdense_ls *b = (bdense_ls *)ls;
+  const int n = ls->n;
+  const double *a = b->a;
+  for (int j = 0; j < nrhs; j += 4) {
+    const int w = nrhs - j < 4 ? nrhs - j : 4;
+    if (w == 1) return bd_solve(ls, x + (size_t)j * n);
+    double *y[4], s[4];
+    for (int r = 0; r < w; r++) {
+      const double *xr = x + (size_t)(j + r) * n;
+      y[r] = b->y + (size_t)r * n;
+      for (int i = 0; i < n; i++) y[r][b->rpos[i]] = xr[i];
+    }
+    for (int k = 0; k < n; k++) { /* L y = P b, unit diagonal; L's rows were not interchanged */
+      const int p = b->piv[k];
+      for (int r = 0; r < w; r++) {
+        s[r] = y[r][p];
+        y[r][p] = y[r][k];
+        y[r][k] = s[r];
+      }
+      update(a + (size_t)k * n, k + 1, n, w, s, y);
+    }
+    for (int k = n - 1; k >= 0; k--) { /* U x = y */
+      const double *ck = a + (size_t)k * n;
+      for (int r = 0; r < w; r++) s[r] = y[r][k] /= ck[k];
+      update(ck, 0, k, w, s, y);
+    }
+    for (int r = 0; r < w; r++) {
+      double *xr = x + (size_t)(j + r) * n;
+      for (int i = 0; i < n; i++) xr[i] = y[r][b->cpos[i]];
+    }
+  }
+  return FESD_OK;
+}
+
+static const fesd__ls_ops bdense_ops = {FESD__LS_LU, FESD__LAYOUT_CSC, 0,          bd_analyze,
+                                        bd_factor,   bd_solve,         bd_destroy, bd_solve_many};
 
 int fesd__ls_bdense_create(fesd__ls **ls, int n, int max_nz) {
   bdense_ls *b = calloc(1, sizeof *b);
@@ -238,7 +305,7 @@ int fesd__ls_bdense_create(fesd__ls **ls, int n, int max_nz) {
   b->rhi0 = malloc(nn * sizeof(int));
   b->chi = malloc(nn * sizeof(int));
   b->rhi = malloc(nn * sizeof(int));
-  b->y = malloc(nn * sizeof(double));
+  b->y = malloc(4 * nn * sizeof(double)); /* 4 columns: bd_solve_many */
   if (!b->rpos || !b->cpos || !b->src || !b->a || !b->piv || !b->list || !b->tmp || !b->y || !b->chi0 || !b->rhi0 || !b->chi || !b->rhi) {
     bd_destroy(&b->base);
     return FESD_ERR_NOMEM;

@@ -143,36 +143,49 @@ static int bls_factor(fesd__ls *ls, double *values, double mu) {
   return info == 0 ? FESD_OK : full_factor(b, values);
 }
 
-static int bls_solve(fesd__ls *ls, double *x) {
+/* nrhs columns of x (leading dimension n), up to 4 at a time: one KLU solve with A for the
+ * block (the factors traversed once), the border per column. */
+static int bls_solve_many(fesd__ls *ls, double *x, int nrhs) {
   border_ls *b = (border_ls *)ls;
   const int n = ls->n, nb = b->nb, ni = b->ni;
-  if (b->use_full) return b->full->ops->solve(b->full, x);
-  double *y = b->bcopy, *r = b->rb_vec; /* y: interior (ni), r: border (nb) */
-  for (int i = 0; i < n; i++) {
-    const int t = b->rmap[i];
-    if (t >= 0) y[t] = x[i];
-    else r[-1 - t] = x[i];
-  }
-  int rc = b->inner->ops->solve(b->inner, y);
-  if (rc) return rc;
-  for (int q = 0; q < b->nC; q++) r[b->C_r[q]] -= b->Cx[q] * y[b->C_c[q]];
-  int info = 0, one = 1;
-  if (nb > 0) dgetrs_("N", &nb, &one, b->S, &nb, b->piv, r, &nb, &info, 1);
-  if (info) return FESD_ERR_LINSOLVE;
-  for (int c = 0; c < nb; c++) {
-    const double *w = b->W + (size_t)c * ni, xc = r[c];
-    if (xc != 0.0)
-      for (int i = 0; i < ni; i++) y[i] -= w[i] * xc;
-  }
-  for (int j = 0; j < n; j++) {
-    const int t = b->cmap[j];
-    x[j] = t >= 0 ? y[t] : r[-1 - t];
+  if (b->use_full) return fesd__ls_klu_solve_many(b->full, x, nrhs);
+  for (int j = 0; j < nrhs; j += 4) {
+    const int w = nrhs - j < 4 ? nrhs - j : 4;
+    for (int c = 0; c < w; c++) { /* y: interior (ni), r: border (nb) of each column */
+      const double *xc = x + (size_t)(j + c) * n;
+      double *y = b->bcopy + (size_t)c * ni, *r = b->rb_vec + (size_t)c * nb;
+      for (int i = 0; i < n; i++) {
+        const int t = b->rmap[i];
+        if (t >= 0) y[t] = xc[i];
+        else r[-1 - t] = xc[i];
+      }
+    }
+    int rc = fesd__ls_klu_solve_many(b->inner, b->bcopy, w);
+    if (rc) return rc;
+    for (int c = 0; c < w; c++) {
+      double *xc = x + (size_t)(j + c) * n, *y = b->bcopy + (size_t)c * ni, *r = b->rb_vec + (size_t)c * nb;
+      for (int q = 0; q < b->nC; q++) r[b->C_r[q]] -= b->Cx[q] * y[b->C_c[q]];
+      int info = 0, one = 1;
+      if (nb > 0) dgetrs_("N", &nb, &one, b->S, &nb, b->piv, r, &nb, &info, 1);
+      if (info) return FESD_ERR_LINSOLVE;
+      for (int k = 0; k < nb; k++) {
+        const double *wk = b->W + (size_t)k * ni, xk = r[k];
+        if (xk != 0.0)
+          for (int i = 0; i < ni; i++) y[i] -= wk[i] * xk;
+      }
+      for (int i = 0; i < n; i++) {
+        const int t = b->cmap[i];
+        xc[i] = t >= 0 ? y[t] : r[-1 - t];
+      }
+    }
   }
   return FESD_OK;
 }
 
-static const fesd__ls_ops border_ops = {FESD__LS_LU, FESD__LAYOUT_CSC, 0, bls_analyze,
-                                        bls_factor,  bls_solve,        bls_destroy};
+static int bls_solve(fesd__ls *ls, double *x) { return bls_solve_many(ls, x, 1); }
+
+static const fesd__ls_ops border_ops = {FESD__LS_LU, FESD__LAYOUT_CSC, 0,           bls_analyze,
+                                        bls_factor,  bls_solve,        bls_destroy, bls_solve_many};
 
 int fesd__ls_border_create(fesd__ls **ls, int n, int nb) {
   border_ls *b = calloc(1, sizeof *b);
@@ -191,8 +204,8 @@ int fesd__ls_border_create(fesd__ls **ls, int n, int nb) {
   b->D_src = malloc(nbb * nbb * sizeof(int));
   b->W = malloc((ni > 0 ? ni : 1) * nbb * sizeof(double));
   b->S = malloc(nbb * nbb * sizeof(double));
-  b->bcopy = malloc((ni > 0 ? ni : 1) * sizeof(double));
-  b->rb_vec = malloc(nbb * sizeof(double));
+  b->bcopy = malloc(4 * (ni > 0 ? ni : 1) * sizeof(double)); /* 4 columns: bls_solve_many */
+  b->rb_vec = malloc(4 * nbb * sizeof(double));
   b->piv = malloc(nbb * sizeof(int));
   int rc = FESD_OK;
   if (!b->rmap || !b->cmap || !b->Ap || !b->D_r || !b->D_c || !b->D_src || !b->W || !b->S || !b->bcopy ||

@@ -83,7 +83,7 @@ static void chol_destroy(fesd__ls *ls) {
 }
 
 static const fesd__ls_ops chol_ops = {FESD__LS_NORMAL, FESD__LAYOUT_CSC_T, 0,           chol_analyze,
-                                      chol_factor,     chol_solve,         chol_destroy};
+                                      chol_factor,     chol_solve,         chol_destroy, NULL};
 
 int fesd__ls_cholmod_create(fesd__ls **ls, int n) {
   chol_ls *h = calloc(1, sizeof *h);

@@ -53,14 +53,25 @@ static int lu_solve(fesd__ls *ls, double *x) {
   return info == 0 ? FESD_OK : FESD_ERR_LINSOLVE;
 }
 
+static int lu_solve_many(fesd__ls *ls, double *x, int nrhs) {
+  dense_lu *d = (dense_lu *)ls;
+  if (ls->n > SMALL_LU_MAX_N) { /* dgetrs with several columns blocks differently */
+    int rc = FESD_OK;
+    for (int j = 0; j < nrhs && rc == FESD_OK; j++) rc = lu_solve(ls, x + (size_t)j * ls->n);
+    return rc;
+  }
+  fesd__dense_lu_solve_many(ls->n, d->lu, d->ipiv, x, nrhs);
+  return FESD_OK;
+}
+
 static void lu_destroy(fesd__ls *ls) {
   dense_lu *d = (dense_lu *)ls;
   free(d->ipiv);
   free(d);
 }
 
-static const fesd__ls_ops dense_lu_ops = {FESD__LS_LU, FESD__LAYOUT_DENSE, 1, dense_analyze,
-                                          lu_factor,   lu_solve,           lu_destroy};
+static const fesd__ls_ops dense_lu_ops = {FESD__LS_LU, FESD__LAYOUT_DENSE, 1,          dense_analyze,
+                                          lu_factor,   lu_solve,           lu_destroy, lu_solve_many};
 
 int fesd__ls_dense_lu_create(fesd__ls **ls, int n) {
   dense_lu *d = calloc(1, sizeof *d);
@@ -103,7 +114,7 @@ static void normal_destroy(fesd__ls *ls) {
 
 static const fesd__ls_ops dense_normal_ops = {FESD__LS_NORMAL, FESD__LAYOUT_DENSE, 0,
                                               dense_analyze,   normal_factor,      normal_solve,
-                                              normal_destroy};
+                                              normal_destroy,  NULL};
 
 int fesd__ls_dense_normal_create(fesd__ls **ls, int n) {
   dense_normal *d = calloc(1, sizeof *d);

@@ -163,8 +163,8 @@ int fesd__ls_klu_solve_many(fesd__ls *ls, double *x, int nrhs) {
   return klu_solve(k->cur->symbolic, k->cur->numeric, ls->n, nrhs, x, &k->common) ? FESD_OK : FESD_ERR_LINSOLVE;
 }
 
-static const fesd__ls_ops klu_ops = {FESD__LS_LU, FESD__LAYOUT_CSC, 0,          kls_analyze,
-                                     kls_factor,  kls_solve,        kls_destroy};
+static const fesd__ls_ops klu_ops = {FESD__LS_LU, FESD__LAYOUT_CSC, 0,           kls_analyze,
+                                     kls_factor,  kls_solve,        kls_destroy, fesd__ls_klu_solve_many};
 
 int fesd__ls_klu_create(fesd__ls **ls, int n) {
   klu_ls *k = calloc(1, sizeof *k);

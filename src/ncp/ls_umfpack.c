@@ -80,7 +80,7 @@ static void umf_destroy(fesd__ls *ls) {
 }
 
 static const fesd__ls_ops umf_ops = {FESD__LS_LU, FESD__LAYOUT_CSC, 0,          umf_analyze,
-                                     umf_factor,  umf_solve,        umf_destroy};
+                                     umf_factor,  umf_solve,        umf_destroy, NULL};
 
 int fesd__ls_umfpack_create(fesd__ls **ls, int n) {
   umf_ls *u = calloc(1, sizeof *u);

@@ -5,6 +5,9 @@
 #include "fesd_ncp.h"
 #include "ncp/linsolve.h"
 
+/* Right-hand sides per block of the sensitivity solves (sensitivity.c). */
+#define FESD__SENS_BLOCK 4
+
 /* Accumulated statistics of one public call (copied into fesd_ncp_info). */
 typedef struct {
   int iterations, stages, factorizations, evals, jac_evals, backtracks;
@@ -60,6 +63,8 @@ struct fesd_ncp {
   int has_box;
 
   fesd__ncp_stats pending; /* sensitivity work, reported by the next solve */
+  double *sens_jv;         /* nnz: weighted Jacobian entries of the sensitivity checks */
+  double *sens_blk;        /* 3 FESD__SENS_BLOCK n: a block's right-hand sides, residuals, sizes */
   double sens_residual;    /* worst relative residual of the last sensitivity solves */
   double sens_ferr;        /* worst forward-error estimate of the last sensitivity solves */
 };

@@ -62,7 +62,8 @@ void fesd_ncp_free(fesd_ncp **pws) {
                     ws->act_r,   ws->act_c,    ws->sp_p,    ws->sp_i,      ws->work,
                     ws->vals,    ws->wgt,      ws->raw_c,   ws->raw_t,     ws->jac_c,
                     ws->F_c,      ws->F_t,     ws->zt,        ws->d,
-                    ws->g,       ws->tmp,      ws->z0,      ws->lb,        ws->ub};
+                    ws->g,       ws->tmp,      ws->z0,      ws->lb,        ws->ub,
+                    ws->sens_jv, ws->sens_blk};
   for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++) free(arrays[i]);
   free(ws);
   *pws = NULL;
@@ -109,6 +110,8 @@ static int allocate(fesd_ncp *ws) {
   ws->z0 = alloc(n, sizeof(double), &fail);
   ws->lb = alloc(n, sizeof(double), &fail);
   ws->ub = alloc(n, sizeof(double), &fail);
+  ws->sens_jv = alloc(nnz, sizeof(double), &fail);
+  ws->sens_blk = alloc(3 * FESD__SENS_BLOCK * n, sizeof(double), &fail);
   return fail ? FESD_ERR_NOMEM : FESD_OK;
 }
 
