@@ -149,15 +149,15 @@ static int chain_sensitivities(fesd_integrator *it, const double *z) {
   fesd__system *S = &it->sys;
   fesd__level *L = &it->lv[it->lv_cur];
   const int nx = it->nx, nu = it->nu, np = nx + nu;
+  /* the stage points with their u-derivatives; want_u stays on through the solver's evaluation
+   * at z, which then finds them and only assembles its rows */
   S->want_u = 1;
-  int st = fesd__system_eval(z, it->raw, L->jac, S);
-  if (st) {
-    S->want_u = 0;
-    return S->status ? S->status : FESD_ERR_CALLBACK;
+  int st = S->status = fesd__system_points(S, z, 1);
+  if (!st) {
+    fesd__system_param_jac(S, z, L->draw);
+    st = fesd_ncp_sensitivity(it->ncp, z, 0.0, np, L->draw, L->dz);
   }
-  fesd__system_param_jac(S, z, L->draw);
   S->want_u = 0;
-  st = fesd_ncp_sensitivity(it->ncp, z, 0.0, np, L->draw, L->dz);
   if (st == FESD_ERR_CALLBACK && S->status) st = S->status; /* the model's own status */
   if (st) return st;
   double rel = 0, ferr = 0;

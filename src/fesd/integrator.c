@@ -54,7 +54,6 @@ static int validate_settings(const fesd_settings *s) {
 
 static void level_free(fesd__level *L) {
   fesd_ncp_free(&L->ncp);
-  free(L->jac);
   free(L->draw);
   free(L->dz);
   memset(L, 0, sizeof(*L));
@@ -112,10 +111,9 @@ int fesd__use_level(fesd_integrator *it, int N) {
     free(col);
     if (st == FESD_OK && it->set.sensitivities) {
       const size_t np = (size_t)it->np;
-      L->jac = malloc((nnz > 0 ? nnz : 1) * sizeof(double));
       L->draw = malloc((size_t)S->n_raw * np * sizeof(double) + 1);
       L->dz = malloc((size_t)S->n * np * sizeof(double) + 1);
-      if (!L->jac || !L->draw || !L->dz) st = FESD_ERR_NOMEM;
+      if (!L->draw || !L->dz) st = FESD_ERR_NOMEM;
     }
     if (st) {
       level_free(L);
@@ -152,7 +150,6 @@ static void lay_out(fesd_integrator *it, const fesd_settings *settings, fesd__bl
   it->z0 = fesd__block_doubles(B, n);
   it->zpred = fesd__block_doubles(B, n);
   it->zp = fesd__block_doubles(B, n);
-  it->raw = fesd__block_doubles(B, (size_t)S->n_raw);
   /* sensitivity storage is O(n_x^2): only when asked for */
   const size_t sx = settings->sensitivities ? nx : 1;
   for (fesd__saved *b = &it->bk; b <= &it->bk_sub; b++) {

@@ -21,7 +21,7 @@
 typedef struct {
   int N;
   fesd_ncp *ncp;
-  double *jac, *draw, *dz;
+  double *draw, *dz;
 } fesd__level;
 
 /* A switch of one subsystem inside the step, as planned for the next solve (plan.c). */
@@ -89,7 +89,7 @@ struct fesd_integrator {
   double *ap_lam, *ap_rate, *ap_lam_b, *ap_rate_b, *ap_th, ap_t;
   int have_state, have_ws, have_prev_theta;
   /* step data (sized for N_cap elements) */
-  double *z, *z0, *zpred, *zp, *raw;
+  double *z, *z0, *zpred, *zp;
   unsigned char *eq_active, *pair_mode, *raw_border, *col_border;
   fesd__saved bk, bk_sub; /* step start, sub-step start */
   /* sensitivities */
