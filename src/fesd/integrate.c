@@ -306,7 +306,7 @@ static int integrate(fesd_integrator *it, const double *u, double t_out, fesd_in
     double hh = graze_retry ? fmin(h, left) : h >= 0.99 * left ? left : (h > 0.5 * left ? 0.5 * left : h);
     graze_retry = 0;
     fesd_step_info si;
-    if (!(it->ap_t == it->t) && (st = fesd__graze_rates(it, u, it->ap_lam, it->ap_rate))) break;
+    if (!(it->ap_t == it->t) && (st = fesd__graze_rates(it, u, it->ap_lam, it->ap_rate, it->ap_m))) break;
     it->ap_t = it->t;
     it->newton_tol = solve_tolerance(it);
     st = fesd_step(it, u, hh, &si);
@@ -341,7 +341,7 @@ static int integrate(fesd_integrator *it, const double *u, double t_out, fesd_in
       continue;
     }
     /* a graze inside the step (graze.c): retried to end at it */
-    if ((st = fesd__graze_rates(it, u, it->ap_lam_b, it->ap_rate_b))) break;
+    if ((st = fesd__graze_rates(it, u, it->ap_lam_b, it->ap_rate_b, it->ap_m_b))) break;
     const double t_dip = fesd__graze_dip(it, hh, it->ap_lam, it->ap_rate, it->ap_lam_b, it->ap_rate_b);
     if (t_dip > 0) {
       rollback(it);
@@ -351,6 +351,8 @@ static int integrate(fesd_integrator *it, const double *u, double t_out, fesd_in
       graze_retry = 1;
       continue;
     }
+    const double cap = fesd__slide_cap(it, hh, it->ap_m, it->ap_m_b);
+    memcpy(it->ap_m, it->ap_m_b, (size_t)it->nsys * sizeof(double));
     memcpy(it->ap_lam, it->ap_lam_b, (size_t)it->nth * sizeof(double));
     memcpy(it->ap_rate, it->ap_rate_b, (size_t)it->nth * sizeof(double));
     it->ap_t = it->t;
@@ -388,6 +390,7 @@ static int integrate(fesd_integrator *it, const double *u, double t_out, fesd_in
       fpi = 0.9 * pow(err, -0.7 / it->err_q) * pow(it->ec_err_prev, 0.4 / it->err_q);
     h = hh * fmin(it->ec_rejected ? 1.0 : 5.0, fmax(0.2, fpi));
     h = fmin(h, switch_limit(it, hh, it->log_n - logged));
+    h = fmax(fmin(h, cap), hmin);
     it->ec_err_prev = fmax(err, 1e-4);
     it->ec_rejected = 0;
     if (one_step) break;

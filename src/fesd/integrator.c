@@ -144,6 +144,8 @@ static void lay_out(fesd_integrator *it, const fesd_settings *settings, fesd__bl
   it->ap_lam_b = fesd__block_doubles(B, nth);
   it->ap_rate_b = fesd__block_doubles(B, nth);
   it->ap_th = fesd__block_doubles(B, nth);
+  it->ap_m = fesd__block_doubles(B, nsys);
+  it->ap_m_b = fesd__block_doubles(B, nsys);
   it->u_cur = fesd__block_doubles(B, nu);
   it->ws_blk = fesd__block_doubles(B, (size_t)S->sb);
   it->z = fesd__block_doubles(B, n);

@@ -87,6 +87,7 @@ struct fesd_integrator {
   /* graze check of fesd_integrate (graze.c): lambda and its rate at the start of the step (a)
    * and at its end (b), per mode; ap_th scratch thetas; ap_t: the time the (a) values hold at */
   double *ap_lam, *ap_rate, *ap_lam_b, *ap_rate_b, *ap_th, ap_t;
+  double *ap_m, *ap_m_b; /* nsys: Filippov margins of the sliding subsystems at both step ends */
   int have_state, have_ws, have_prev_theta;
   /* step data (sized for N_cap elements) */
   double *z, *z0, *zpred, *zp;
@@ -217,7 +218,8 @@ int fesd__ladder(const fesd_integrator *it, int N);
 double fesd__hermite_min(double a, double b, double da, double db, double *tau);
 double fesd__hermite_first_zero(double a, double b, double da, double db, double tau);
 /* Graze check of an error-controlled step (graze.c). */
-int fesd__graze_rates(fesd_integrator *it, const double *u, double *lam, double *rate);
+int fesd__graze_rates(fesd_integrator *it, const double *u, double *lam, double *rate, double *margin);
+double fesd__slide_cap(const fesd_integrator *it, double hh, const double *m_a, const double *m_b);
 double fesd__graze_dip(const fesd_integrator *it, double hh, const double *lam_a, const double *rate_a,
                        const double *lam_b, const double *rate_b);
 /* Whether the method has a collocation polynomial (dense output, interior checks). */
