@@ -195,11 +195,17 @@ static int log_events(fesd_integrator *it, int stopping, int stop_up) {
     int st = log_append(it, &ev[e]);
     if (st) return st;
   }
-  /* a condition that crossed back is armed again */
+  fesd__rearm_stops(it);
+  return FESD_OK;
+}
+
+void fesd__rearm_stops(fesd_integrator *it) {
+  const fesd_event *ev;
+  int ne;
+  fesd_last_events(it, &ev, &ne);
   for (int e = 0; e < ne; e++)
     if (ev[e].kind == FESD_EVENT_ROOT && it->stop_dir[ev[e].sys] == (crosses_up(&ev[e]) ? -1 : 1))
       it->stop_dir[ev[e].sys] = 0;
-  return FESD_OK;
 }
 
 /* The stop at t_root on condition k: logged now (the step ends on the root, so the change of

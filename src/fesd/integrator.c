@@ -489,6 +489,9 @@ int fesd_step(fesd_integrator *it, const double *u, double T, fesd_step_info *in
   S->ambiguous_steps += (info->flags & FESD_FLAG_AMBIGUOUS) != 0;
   S->events += it->n_events;
   S->time += info->time;
+  /* a stop condition crossing back in a step of plain fesd_step: its next crossing in the stop's
+   * direction is a new stop (measured: skipped, the integration stopped a period later) */
+  if (!it->ec_on && it->n_events > 0) fesd__rearm_stops(it);
   int sw = info->switch_step || info->splits > 0 || info->substeps > 0;
   it->last_sw = sw;
   it->last_iter = info->newton_iter;

@@ -220,6 +220,9 @@ double fesd__hermite_first_zero(double a, double b, double da, double db, double
 /* Graze check of an error-controlled step (graze.c). */
 int fesd__graze_rates(fesd_integrator *it, const double *u, double *lam, double *rate, double *margin);
 double fesd__slide_cap(const fesd_integrator *it, double hh, const double *m_a, const double *m_b);
+/* A stop condition that crossed back against its last stop's direction in the last step is armed
+ * again (integrate.c; also after steps of plain fesd_step between integration calls). */
+void fesd__rearm_stops(fesd_integrator *it);
 double fesd__graze_dip(const fesd_integrator *it, double hh, const double *lam_a, const double *rate_a,
                        const double *lam_b, const double *rate_b);
 /* Whether the method has a collocation polynomial (dense output, interior checks). */

@@ -14,7 +14,11 @@
  *    1e-8 short of its root stopped again on the same crossing: 4 of 21 runs);
  *  - max_steps bounds fesd_integrate_grid (its dense path integrated step by step and never
  *    reached it: 6450 steps with max_steps = 50);
- *  - root_dir outside -1, 0, +1 is refused. */
+ *  - root_dir outside -1, 0, +1 is refused;
+ *  - a stop, then plain fesd_step calls through the condition's crossing back, then
+ *    fesd_integrate: x = cos(t + 0.3), stop at x = 1/2 decreasing: the next stop is the next
+ *    decreasing crossing, 2 pi + acos(1/2) - 0.3 (the review of the stop bookkeeping: it was
+ *    skipped, the integration stopped a period later at 13.31), also through fesd_integrate. */
 #include <math.h>
 #include <stdio.h>
 
@@ -43,6 +47,58 @@ static int fo_root(double t, const double *x, const double *u, double *r, void *
   (void)t, (void)u, (void)user;
   r[0] = x[0] + 2.0;
   return 0;
+}
+
+static int osc_field(int sys, int mode, double t, const double *x, const double *u, double *f, void *user) {
+  (void)sys, (void)mode, (void)t, (void)u, (void)user;
+  f[0] = x[1], f[1] = -x[0];
+  return 0;
+}
+static int osc_sw(int sys, double t, const double *x, const double *u, double *c, void *user) {
+  (void)sys, (void)t, (void)u, (void)user;
+  c[0] = x[0] + 100.0; /* never switches */
+  return 0;
+}
+static int osc_root(double t, const double *x, const double *u, double *r, void *user) {
+  (void)t, (void)u, (void)user;
+  r[0] = x[0] - 0.5;
+  return 0;
+}
+
+/* stop, then steps through the crossing back (plain fesd_step: via = 0, fesd_integrate: 1),
+ * then the next stop */
+static int stop_step_stop(int via) {
+  int fails = 0;
+  const int nm[1] = {2}, ns[1] = {1}, rd[1] = {-1};
+  fesd_model m = {.nx = 2, .nsys = 1, .n_modes = nm, .n_switch = ns, .field = osc_field, .sw = osc_sw,
+                  .n_roots = 1, .roots = osc_root, .root_dir = rd};
+  fesd_settings set;
+  fesd_settings_default(&set);
+  set.stages = 3;
+  fesd_integrator *it;
+  if (fesd_create(&it, &m, &set)) return 1;
+  fesd_tolerances tol;
+  fesd_tolerances_default(&tol);
+  tol.rtol = 1e-8, tol.atol = 1e-10;
+  fesd_set_tolerances(it, &tol);
+  double x[2] = {cos(0.3), -sin(0.3)}, t1, t2;
+  fesd_set_state(it, 0, x, NULL);
+  fesd_integrate_info info;
+  const int st1 = fesd_integrate(it, NULL, 20, &info);
+  fesd_get_state(it, &t1, x);
+  if (via == 0)
+    for (int i = 0; i < 100; i++) fesd_step(it, NULL, (5.5 - t1) / 100, NULL);
+  else
+    fesd_integrate(it, NULL, 5.5, &info);
+  const int st2 = fesd_integrate(it, NULL, 20, &info);
+  fesd_get_state(it, &t2, x);
+  const double e1 = acos(0.5) - 0.3, e2 = e1 + 2 * acos(-1.0);
+  printf("stop, %s through the crossing back, stop: %s at %.9f, %s at %.9f (exact %.9f, %.9f)\n",
+         via ? "fesd_integrate" : "fesd_step", fesd_status_name(st1), t1, fesd_status_name(st2), t2, e1, e2);
+  FESD_TEST_CHECK(st1 == FESD_ROOT && st2 == FESD_ROOT && fabs(t1 - e1) <= 1e-6 && fabs(t2 - e2) <= 1e-6,
+                  "via %d: stops %.9f %.9f", via, t1, t2);
+  fesd_free(&it);
+  return fails;
 }
 
 int main(void) {
@@ -239,6 +295,7 @@ int main(void) {
     FESD_TEST_CHECK(fesd_create(&it, &fo, &set) == FESD_ERR_MODEL, "root_dir -7 accepted");
     fesd_free(&it);
   }
+  fails += stop_step_stop(0) + stop_step_stop(1);
   printf("%d failures\n", fails);
   return fails != 0;
 }

@@ -13,8 +13,9 @@
  * the midpoint check (whose allowance was 10 %): FESD_OK, unflagged, x(30) 6e4 tolerances off.
  * Seeded random parameters with long stick phases and short slips (forcing just above the
  * friction), starts stuck; Radau IIA s = 3, 5 and Lobatto IIIC s = 4 at rtol 1e-6 and 1e-9.
- * Checks: FESD_OK, the reference's events (kind and time within 1e-4 / 1e-6), x(T) within
- * 2000 tolerances (each exit adds about one). Counts printed. */
+ * Checks: FESD_OK, the reference's events (kind and time within 1e-4 / 1e-6; a stick phase
+ * shorter than 1e-2 may be logged as a crossing, counted), x(T) within 2000 tolerances (each exit
+ * adds about one). Counts printed. */
 #include "hard_util.h"
 
 typedef struct {
@@ -133,7 +134,7 @@ int main(void) {
   const double rtols[] = {1e-6, 1e-9};
   const int n_modes[1] = {2}, n_switch[1] = {1};
   unsigned long long seed = 20261128ULL;
-  int runs = 0, right = 0, wrong_ev = 0, wrong_x = 0, failed = 0, events = 0, flagged_wrong = 0;
+  int runs = 0, right = 0, wrong_ev = 0, wrong_x = 0, failed = 0, events = 0, flagged_wrong = 0, short_sticks = 0;
   double worst = 0;
   for (int c = 0; c < 24; c++) {
     fso p;
@@ -184,9 +185,21 @@ int main(void) {
           fesd_free(&it);
           continue;
         }
-        int same = ne == E.n;
-        for (int e = 0; e < ne && same; e++)
-          same = (int)ev[e].kind == E.kind[e] && fabs(ev[e].t - E.t[e]) <= (r == 0 ? 1e-4 : 1e-6);
+        /* the reference's events in kind and time; a stick phase shorter than 1e-2 may come as
+         * one crossing (the switch-point check allows the entered field to point back by 1e-2 of
+         * the normal components: a near-tangential arrival whose stick condition holds by that
+         * little; measured once, a stick of 6.9e-3 at rtol 1e-6, x(T) 4e-6 tolerances off) */
+        const double ttol = r == 0 ? 1e-4 : 1e-6;
+        int same = 1, il = 0, ir = 0; /* library, reference */
+        for (; il < ne && ir < E.n && same; il++, ir++) {
+          if (ev[il].kind == FESD_EVENT_CROSSING && E.kind[ir] == FESD_EVENT_SLIDING_ENTRY && ir + 1 < E.n &&
+              E.t[ir + 1] - E.t[ir] < 1e-2 && fabs(ev[il].t - E.t[ir]) <= ttol) {
+            ir++, short_sticks++;
+            continue;
+          }
+          same = (int)ev[il].kind == E.kind[ir] && fabs(ev[il].t - E.t[ir]) <= ttol;
+        }
+        same = same && il == ne && ir == E.n;
         const double err = fmax(fabs(x[0] - xr[0]), fabs(x[1] - xr[1])) / (tol.rtol * (1 + fabs(xr[0])));
         worst = fmax(worst, err);
         events += ne;
@@ -203,8 +216,9 @@ int main(void) {
       }
   }
   printf("forced stick-slip, T = %.0f: %d runs, %d right, %d with other events, %d with x(T) off (%d of the wrong "
-         "ones flagged), %d failed; %d events; worst x(T) error %.2g tolerances\n",
-         T, runs, right, wrong_ev, wrong_x, flagged_wrong, failed, events, worst);
+         "ones flagged), %d failed; %d events; worst x(T) error %.2g tolerances; %d stick phases < 1e-2 logged as a "
+         "crossing\n",
+         T, runs, right, wrong_ev, wrong_x, flagged_wrong, failed, events, worst, short_sticks);
   HD_CHECK(right == runs, "%d of %d runs wrong or failed", runs - right, runs);
   printf("%d failures\n", fails);
   return fails != 0;
