@@ -208,6 +208,8 @@ static void lay_out(fesd_integrator *it, const fesd_settings *settings, fesd__bl
   it->bseg = fesd__block_take(B, (cp + 2) * sizeof(int), 0);
   it->fil_th = fesd__block_doubles(B, nth);
   it->herm = fesd__block_doubles(B, 2 * nth);
+  it->fil_mi = fesd__block_doubles(B, nsys * s);
+  it->fil_mj = fesd__block_doubles(B, nsys * s);
   it->slide_tmp = fesd__block_doubles(B, 2 * nx);
   it->fil_a = fesd__block_take(B, nth, 0);
   fesd__point_take(&it->model, &it->pscr, 1, B);

@@ -106,6 +106,7 @@ struct fesd_integrator {
   int gn_warm;    /* the warm start solved the last element as it was: check it first */
   double *fil_th;         /* nth: multipliers of an alternative (verify.c) */
   double *herm;           /* 2 nth: distance and rate of each mode at an element start (verify_between.c) */
+  double *fil_mi, *fil_mj; /* nsys s: normalised normal components at the stages (verify.c) */
   double *slide_tmp;      /* 2 nx: the coupled sliding multipliers (fesd__stage_theta) */
   unsigned char *fil_a;   /* nth: its active flags */
   int *gn_piv;
