@@ -365,6 +365,7 @@ int fesd_set_state(fesd_integrator *it, double t0, const double *x0, const doubl
   it->h_next = 0;
   it->log_n = 0;
   memset(it->stop_dir, 0, (size_t)it->nsys);
+  it->last_stop_t = NAN;
   it->ap_t = NAN;
   it->ec_rejected = 0;
   it->ec_err_prev = 0;

@@ -178,6 +178,7 @@ struct fesd_integrator {
   int log_n, log_cap;
   int ec_rejected;     /* error control: the last step attempt was rejected (no growth) */
   double ec_err_prev;  /* ... and the last accepted error estimate (PI control; 0: none) */
+  double last_stop_t;    /* the time of the last stop (NaN: none since fesd_set_state) */
   signed char *stop_dir; /* per stop condition: the direction of its last stop (1 increasing,
                             -1 decreasing) until it crosses back, 0 then: its crossings in that
                             direction meanwhile are that stop (integrate.c, same_stop) */
