@@ -54,7 +54,6 @@ void fesd__dense_lu_solve(int n, const double *a, const int *piv, double *x) {
   }
 }
 
-
 /* Columns x0..x(w-1) (w <= 4) at once: each factor entry is loaded once for all of them, and
  * each column gets the operations of fesd__dense_lu_solve in its order (bit for bit). Called
  * with a constant w, so that the compiler drops the unused columns. */

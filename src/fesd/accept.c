@@ -152,13 +152,12 @@ static int chain_sensitivities(fesd_integrator *it, const double *z) {
    * 1e-10 before a step end gave dx/dx0 = I and dx/du = 0 where the map's differences and the
    * flow give [1 0.5; 0 0] and (-0.5, 1); inside the step (1e-9 T on) it is exact. */
   if (it->start_jumped && !it->tab.stiffly_accurate)
-    for (int i = 0; i < it->nth; i++)
-      if (it->act0[i] && !it->act_first[i]) {
-        const int k = it->model.sys_of[i];
-        int out = 0;
-        for (int l = it->model.th_off[k]; l < it->model.th_off[k + 1]; l++) out |= it->act_first[l] && !it->act0[l];
-        if (!out) it->step_flags |= FESD_FLAG_SENS_INACCURATE;
-      }
+    for (int k = 0; k < it->nsys; k++) {
+      int in = 0, out = 0;
+      for (int l = it->model.th_off[k]; l < it->model.th_off[k + 1]; l++)
+        in |= it->act0[l] && !it->act_first[l], out |= it->act_first[l] && !it->act0[l];
+      if (in && !out) it->step_flags |= FESD_FLAG_SENS_INACCURATE;
+    }
   fesd__system *S = &it->sys;
   fesd__level *L = &it->lv[it->lv_cur];
   const int nx = it->nx, nu = it->nu, np = nx + nu;
@@ -249,7 +248,6 @@ static int euler_exit(const fesd_integrator *it, int n, int k, int *out, int c) 
   out[p] = x;
   return c + 1;
 }
-
 
 /* Room for need events (doubling; at acceptance, outside the Newton loop: a step with more
  * switches than any before). A step records at most nsys events per element boundary and at

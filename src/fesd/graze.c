@@ -16,8 +16,8 @@
 
 /* lambda of every mode at the current state and its rate along the total field (theta of the
  * last stage, or the argmin modes at a fresh start); margin[k]: for a subsystem sliding on two
- * modes i, j, min(a_i, -a_j) / (|a_i| + |a_j|) of their normal components (positive while
- * Filippov's conditions hold, fesd__filippov), NaN otherwise. */
+ * modes, the smaller of its fesd__sliding_margins (positive while Filippov's conditions hold),
+ * NaN otherwise. */
 int fesd__graze_rates(fesd_integrator *it, const double *u, double *lam, double *rate, double *margin) {
   const fesd__model *m = &it->model;
   fesd__point_eval pe = fesd__scratch_eval(it);
@@ -40,9 +40,9 @@ int fesd__graze_rates(fesd_integrator *it, const double *u, double *lam, double 
       if (th[l] > it->set.active_tol) na++, i2 = j2, j2 = l;
     margin[k] = NAN;
     if (na == 2) {
-      double ai, aj;
-      fesd__normal_components(it, &pe, th, it->ftot, i2, j2, &ai, &aj);
-      if (fabs(ai) + fabs(aj) > 0) margin[k] = fmin(ai, -aj) / (fabs(ai) + fabs(aj));
+      double mi, mj;
+      fesd__sliding_margins(it, &pe, th, it->ftot, i2, j2, &mi, &mj);
+      margin[k] = fmin(mi, mj);
     }
     int jmin = -1;
     for (int l = m->th_off[k]; l < m->th_off[k + 1]; l++)

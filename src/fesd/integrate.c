@@ -219,6 +219,18 @@ static int log_stop(fesd_integrator *it, int k, double t_root, int dir) {
   return log_append(it, &ev);
 }
 
+/* The integration stops on condition k at the current time (dir of its crossing): its
+ * direction remembered (same_stop), the stop logged. FESD_ROOT, or the log's failure. */
+static int take_stop(fesd_integrator *it, int k, int dir, fesd_integrate_info *info) {
+  it->stop_dir[k] = (signed char)(dir > 0 ? 1 : -1);
+  it->last_stop_t = it->t;
+  const int st = log_stop(it, k, it->t, dir);
+  if (st) return st;
+  info->events++;
+  info->root = k;
+  return FESD_ROOT;
+}
+
 int fesd_event_log(const fesd_integrator *it, const fesd_event **events, int *count) {
   if (!it || !events || !count) return FESD_ERR_NULL;
   *events = it->log;
@@ -373,11 +385,7 @@ static int integrate(fesd_integrator *it, const double *u, double t_out, fesd_in
     if (root >= 0 && !(t_root > t_start + t_eps)) { /* a stop at the start: the step is undone */
       rollback(it);
       it->stats.rejected_steps--;
-      it->stop_dir[root] = (signed char)(root_dir > 0 ? 1 : -1);
-      if ((st = log_stop(it, root, it->t, root_dir))) break;
-      info->events++;
-      info->root = root;
-      st = FESD_ROOT;
+      st = take_stop(it, root, root_dir, info);
       break;
     }
     if (root >= 0 && t_root < it->t) { /* end the step on the stop condition */
@@ -396,12 +404,7 @@ static int integrate(fesd_integrator *it, const double *u, double t_out, fesd_in
     info->switch_steps += it->log_n > logged;
     info->events += it->log_n - logged;
     if (root >= 0) {
-      it->stop_dir[root] = (signed char)(root_dir > 0 ? 1 : -1);
-      it->last_stop_t = it->t;
-      if ((st = log_stop(it, root, it->t, root_dir))) break;
-      info->events++;
-      info->root = root;
-      st = FESD_ROOT;
+      st = take_stop(it, root, root_dir, info);
       break;
     }
     if (hh == left) break;

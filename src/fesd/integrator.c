@@ -306,11 +306,6 @@ int fesd_create(fesd_integrator **itp, const fesd_model *model, const fesd_setti
   return FESD_OK;
 }
 
-/* A model declared time-independent (time_dependent = 0) whose callbacks depend on t: the step
- * system's derivatives leave out d/dt, and a switch that only time drives cannot be solved
- * (measured: a stop condition r = t - 0.9 ended FESD_ERR_STEP_TOO_SMALL after 36 failed
- * attempts, with nothing saying why). The indicators and the sum of the mode fields at x0 are
- * compared at t0 and a later time; any difference is FESD_ERR_MODEL. */
 /* The sum of the mode fields (f) at x0 at time t, and the indicators (*g: the scratch point's,
  * valid until its next use). */
 static int autonomy_probe(fesd_integrator *it, double t, const double *u, double *f, const double **g) {
@@ -325,6 +320,11 @@ static int autonomy_probe(fesd_integrator *it, double t, const double *u, double
   return FESD_OK;
 }
 
+/* A model declared time-independent (time_dependent = 0) whose callbacks depend on t: the step
+ * system's derivatives leave out d/dt, and a switch that only time drives cannot be solved
+ * (measured: a stop condition r = t - 0.9 ended FESD_ERR_STEP_TOO_SMALL after 36 failed
+ * attempts, with nothing saying why). The indicators and the sum of the mode fields at x0 are
+ * compared at t0 and a later time; any difference is FESD_ERR_MODEL. */
 static int check_autonomous(fesd_integrator *it, const double *u) {
   const int nx = it->model.nx, nth = it->model.nth;
   double *g0 = it->gbuf, *f0 = it->ftot, *f1 = it->ftot + nx;

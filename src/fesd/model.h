@@ -65,12 +65,19 @@ int fesd__model_fields_active(fesd__model *m, double t, const double *x, const d
 /* Only g at (t, x). */
 int fesd__model_g(fesd__model *m, double t, const double *x, const double *u, double *g);
 
-/* y += a f_i (y dense, nx) */
 /* The two active modes (flags a, one per stacked mode) of subsystem k: returns the first and
  * writes the second to *j when exactly two are active (a 2-mode sliding mode), else -1. */
 int fesd__two_modes(const fesd__model *m, const unsigned char *a, int k, int *j);
 /* Whether some subsystem has exactly two active modes in a (a 2-mode sliding mode). */
 int fesd__any_two_modes(const fesd__model *m, const unsigned char *a);
+/* The active mode of subsystem k when exactly one is active in a, else -1. */
+static inline int fesd__one_mode(const fesd__model *m, const unsigned char *a, int k) {
+  int j = -1, cnt = 0;
+  for (int l = m->th_off[k]; l < m->th_off[k + 1]; l++)
+    if (a[l]) j = l, cnt++;
+  return cnt == 1 ? j : -1;
+}
+/* y += a f_i (y dense, nx) */
 void fesd__F_axpy(const fesd__model *m, const fesd__point_eval *pe, int i, double a, double *y);
 /* g = v - sum_i theta_i F_i at the evaluated point: the residual of a stage equation (the step
  * system's V rows, the guess's stage Newton, the certified start solve). */

@@ -292,6 +292,13 @@ static void remove_if_unchanged(fesd_integrator *it, int e) {
   if (!memcmp(after(it, e) + a, set_before_switch(it, e) + a, (size_t)(b - a))) fesd__plan_remove(it, e);
 }
 
+/* Whether subsystem k's sliding mode satisfies Filippov's conditions at switch e of the
+ * current layout (the step start when e < 0), with the sets of all subsystems there. */
+static int stands_at(fesd_integrator *it, const double *z, int e, int k, int *stands) {
+  const unsigned char *A = e < 0 ? it->act : it->act + (size_t)it->plan[e].kb * it->sys.s * it->nth;
+  return fesd__sliding_stands(it, z, e < 0 ? 0.0 : it->plan[e].t, A, k, stands);
+}
+
 /* Returns 1 when the plan changed, 2 when the start's set changed (a switch at the step start),
  * 0 when it gives up, < 0 on errors. */
 static int update_one(fesd_integrator *it, const double *z, const fesd__violation *v, double T) {
@@ -311,8 +318,7 @@ static int update_one(fesd_integrator *it, const double *z, const fesd__violatio
     const double t_a = e < 0 ? 0.0 : it->plan[e].t;
     int stands = 0;
     if (v->t > t_a + AT_START * T && (e < 0 || !it->plan[e].exit)) {
-      const unsigned char *A = e < 0 ? it->act : it->act + (size_t)it->plan[e].kb * it->sys.s * it->nth;
-      int st = fesd__sliding_stands(it, z, t_a, A, k, &stands);
+      int st = stands_at(it, z, e, k, &stands);
       if (st) return st;
     }
     if (stands) {
@@ -353,8 +359,7 @@ static int update_one(fesd_integrator *it, const double *z, const fesd__violatio
      * 0.67: the exit was taken for a wrong entry, the plan cycled, and the finer layout it fell
      * back to gave another solution than a start on the surface: the step map jumped) */
     int stands;
-    const unsigned char *A = it->act + (size_t)it->plan[e].kb * it->sys.s * it->nth;
-    int st = fesd__sliding_stands(it, z, it->plan[e].t, A, k, &stands);
+    int st = stands_at(it, z, e, k, &stands);
     if (st) return st;
     if (stands) {
       later = *v;

@@ -229,11 +229,8 @@ static int certified(fesd_integrator *it, fesd_step_info *info) {
   /* the rows that hold by construction do so to a few eps per term: the sum of the N lengths
    * against T to about N eps, x_{n+1} to about s eps; below that newton_tol is the solver's */
   if (it->full_check || S->look || it->newton_tol < 64.0 * (S->N + S->s) * DBL_EPSILON) return 0;
-  for (int k = 0; k < S->nsys; k++) {
-    int cnt = 0;
-    for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) cnt += it->act0[i] != 0;
-    if (cnt != 1) return 0;
-  }
+  for (int k = 0; k < S->nsys; k++)
+    if (fesd__one_mode(m, it->act0, k) < 0) return 0;
   if (fesd__rows_active(it, it->act, it->bmode, it->exit_mode) || fesd__system_weights(S, it->z)) return 0;
   const double *z = it->z, *w = S->wraw;
   double res = 0, *g = S->tmp;

@@ -66,6 +66,11 @@ static inline void fesd__note_violation(fesd__violation *v, const fesd__violatio
  * for both (repulsive), -2 for none (a sliding mode). */
 int fesd__filippov(fesd_integrator *it, const fesd__point_eval *pe, const double *th, const double *ftot, int i,
                    int j, double rel);
+/* The normal components of a 2-mode sliding mode divided by the sum of their sizes, signed so
+ * that both are >= 0 while Filippov's conditions hold: mi = a_i / d, mj = -a_j / d,
+ * d = |a_i| + |a_j| (NaN when d = 0). The margin of the sliding mode is the smaller. */
+void fesd__sliding_margins(fesd_integrator *it, const fesd__point_eval *pe, const double *th, const double *ftot,
+                           int i, int j, double *mi, double *mj);
 /* Whether a co-dimension-2 sliding mode has a consistent alternative for subsystem k. */
 int fesd__alternative_exists(fesd_integrator *it, const fesd__point_eval *pe, const unsigned char *a, int k, int i,
                              int j);
@@ -77,8 +82,9 @@ int fesd__scan_switch_points(fesd_integrator *it, const double *z, const unsigne
 /* A start within round-off of a surface that its field reaches at once: an entry at that time. */
 int fesd__scan_start(fesd_integrator *it, const double *z, const unsigned char *act, fesd__violation *ps);
 int fesd__scan_interior(fesd_integrator *it, const double *z, const unsigned char *act, fesd__violation *ps);
-/* One-stage methods: an excursion into another mode's region between the two ends of an
- * element (cubic Hermite interpolant of the distance to the surface and its rate). */
+/* Implicit Euler (one stage, c = 1; the caller checks): an excursion into another mode's region
+ * between the two ends of an element (cubic Hermite interpolant of the distance to the surface
+ * and its rate). */
 int fesd__scan_hermite(fesd_integrator *it, const double *z, const unsigned char *act, fesd__violation *ps);
 /* Whether subsystem k's 2-mode sliding in the sets a holds Filippov's conditions at time t of z. */
 int fesd__sliding_stands(fesd_integrator *it, const double *z, double t, const unsigned char *a, int k, int *out);

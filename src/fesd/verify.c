@@ -253,6 +253,15 @@ int fesd__alternative_exists(fesd_integrator *it, const fesd__point_eval *pe, co
   return found;
 }
 
+void fesd__sliding_margins(fesd_integrator *it, const fesd__point_eval *pe, const double *th, const double *ftot,
+                           int i, int j, double *mi, double *mj) {
+  double ai, aj;
+  fesd__normal_components(it, pe, th, ftot, i, j, &ai, &aj);
+  const double d = fabs(ai) + fabs(aj);
+  *mi = d > 0 ? ai / d : NAN;
+  *mj = d > 0 ? -aj / d : NAN;
+}
+
 /* Between the stage points of a sliding element: the normalised normal components a_i / d and
  * -a_j / d (d = |a_i| + |a_j|; both >= 0 while Filippov's conditions hold) are smooth in time and
  * known at the stage points, which lie on the surface (the stage equations hold them there);
@@ -333,11 +342,7 @@ static int scan_filippov(fesd_integrator *it, const double *z, const unsigned ch
           /* the element end where k's set changes is the switch point itself (a sliding exit:
            * the remaining field is tangent there) */
           if (S->tab.c[q] == 1.0 && n + 1 < S->N && set_changes(it, act, n + 1, k)) continue;
-          double ai, aj;
-          fesd__normal_components(it, &pe, th, it->ftot, i, j, &ai, &aj);
-          const double d = fabs(ai) + fabs(aj);
-          it->fil_mi[k * s + q] = d > 0 ? ai / d : NAN;
-          it->fil_mj[k * s + q] = d > 0 ? -aj / d : NAN;
+          fesd__sliding_margins(it, &pe, th, it->ftot, i, j, it->fil_mi + k * s + q, it->fil_mj + k * s + q);
           int c = fesd__filippov(it, &pe, th, it->ftot, i, j, FIL_STAGE_TOL);
           if (c == -2 || !fesd__alternative_exists(it, &pe, a, k, i, j)) continue;
           fesd__violation v = {1, tn + S->tab.c[q] * h, c < 0 ? i : c, k, 0, n, n * s + q, 0, 1, 0, 0};

@@ -103,11 +103,8 @@ int fesd__scan_start(fesd_integrator *it, const double *z, const unsigned char *
   for (int i = 0; i < S->nth; i++) {
     /* inactive modes within round-off of their region first: one test per mode on ordinary steps */
     if (act[i] || !(it->lam00[i] * S->wth[i] < START_REL)) continue;
-    const int k = m->sys_of[i];
-    int j = -1, cnt = 0;
-    for (int l = m->th_off[k]; l < m->th_off[k + 1]; l++)
-      if (act[l]) j = l, cnt++;
-    if (cnt != 1) continue;
+    const int k = m->sys_of[i], j = fesd__one_mode(m, act, k);
+    if (j < 0) continue;
     const double *th = z + fesd__th(S, 0, 0);
     if (!evaluated) {
       pe = fesd__scratch_eval(it);
@@ -199,7 +196,6 @@ int fesd__scan_switch_points(fesd_integrator *it, const double *z, const unsigne
 int fesd__scan_hermite(fesd_integrator *it, const double *z, const unsigned char *act, fesd__violation *ps) {
   fesd__system *S = &it->sys;
   fesd__model *m = &it->model;
-  if (S->s != 1 || !S->tab.c_end_is_one) return FESD_OK;
   const int nth = S->nth;
   double *la = it->herm, *ra = it->herm + nth, tn = 0;
   fesd__point_eval pe = fesd__scratch_eval(it);
@@ -216,10 +212,8 @@ int fesd__scan_hermite(fesd_integrator *it, const double *z, const unsigned char
         f = it->ftot;
       }
       for (int k = 0; k < m->nsys; k++) {
-        int j = -1, cnt = 0;
-        for (int l = m->th_off[k]; l < m->th_off[k + 1]; l++)
-          if (a[l]) j = l, cnt++;
-        if (cnt != 1) continue;
+        const int j = fesd__one_mode(m, a, k);
+        if (j < 0) continue;
         const double gj = pe.g[j], rj = fesd__dg_dot(m, &pe, j, f);
         for (int i = m->th_off[k]; i < m->th_off[k + 1]; i++) {
           if (i == j) continue;

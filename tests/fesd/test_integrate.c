@@ -68,24 +68,34 @@ static int osc_root(double t, const double *x, const double *u, double *r, void 
   return 0;
 }
 
+/* The oscillator x = cos(t + 0.3) with stop conditions (root_dir rd, kept by the caller),
+ * Radau IIA with `stages`, at (0, x(0)); NULL on failure. */
+static fesd_integrator *osc_integrator(int n_roots, fesd_root_fn roots, const int *rd, int stages, double rtol,
+                                       double atol) {
+  static const int nm[1] = {2}, ns[1] = {1};
+  fesd_model m = {.nx = 2, .nsys = 1, .n_modes = nm, .n_switch = ns, .field = osc_field, .sw = osc_sw,
+                  .n_roots = n_roots, .roots = roots, .root_dir = rd};
+  fesd_settings set;
+  fesd_settings_default(&set);
+  set.stages = stages;
+  fesd_integrator *it;
+  if (fesd_create(&it, &m, &set)) return NULL;
+  fesd_tolerances tol;
+  fesd_tolerances_default(&tol);
+  tol.rtol = rtol, tol.atol = atol;
+  const double x[2] = {cos(0.3), -sin(0.3)};
+  if (fesd_set_tolerances(it, &tol) || fesd_set_state(it, 0, x, NULL)) fesd_free(&it);
+  return it;
+}
+
 /* stop, then steps through the crossing back (plain fesd_step: via = 0, fesd_integrate: 1),
  * then the next stop */
 static int stop_step_stop(int via) {
   int fails = 0;
-  const int nm[1] = {2}, ns[1] = {1}, rd[1] = {-1};
-  fesd_model m = {.nx = 2, .nsys = 1, .n_modes = nm, .n_switch = ns, .field = osc_field, .sw = osc_sw,
-                  .n_roots = 1, .roots = osc_root, .root_dir = rd};
-  fesd_settings set;
-  fesd_settings_default(&set);
-  set.stages = 3;
-  fesd_integrator *it;
-  if (fesd_create(&it, &m, &set)) return 1;
-  fesd_tolerances tol;
-  fesd_tolerances_default(&tol);
-  tol.rtol = 1e-8, tol.atol = 1e-10;
-  fesd_set_tolerances(it, &tol);
-  double x[2] = {cos(0.3), -sin(0.3)}, t1, t2;
-  fesd_set_state(it, 0, x, NULL);
+  const int rd[1] = {-1};
+  fesd_integrator *it = osc_integrator(1, osc_root, rd, 3, 1e-8, 1e-10);
+  if (!it) return 1;
+  double x[2], t1, t2;
   fesd_integrate_info info;
   const int st1 = fesd_integrate(it, NULL, 20, &info);
   fesd_get_state(it, &t1, x);
@@ -112,19 +122,9 @@ static int osc_root2(double t, const double *x, const double *u, double *r, void
 
 static int two_together(void) {
   int fails = 0;
-  const int nm[1] = {2}, ns[1] = {1}, rd[2] = {0, 0};
-  fesd_model m = {.nx = 2, .nsys = 1, .n_modes = nm, .n_switch = ns, .field = osc_field, .sw = osc_sw,
-                  .n_roots = 2, .roots = osc_root2, .root_dir = rd};
-  fesd_settings set;
-  fesd_settings_default(&set);
-  fesd_integrator *it;
-  if (fesd_create(&it, &m, &set)) return 1;
-  fesd_tolerances tol;
-  fesd_tolerances_default(&tol);
-  tol.rtol = 1e-6, tol.atol = 1e-8;
-  fesd_set_tolerances(it, &tol);
-  double x[2] = {cos(0.3), -sin(0.3)};
-  fesd_set_state(it, 0, x, NULL);
+  const int rd[2] = {0, 0};
+  fesd_integrator *it = osc_integrator(2, osc_root2, rd, 2, 1e-6, 1e-8);
+  if (!it) return 1;
   /* crossings of cos(t + 0.3) = 1/2 in (0, 30): t = +-acos(1/2) - 0.3 + 2 pi k */
   double tc[16];
   int nc = 0;
