@@ -118,6 +118,8 @@ struct fesd_integrator {
   unsigned char *act, *act0, *cand, *swap_set;
   unsigned char *act_first; /* act0 as classified at the step start, before the plan's start jumps */
   int start_jumped;         /* act_first holds it (a start jump happened in this attempt) */
+  int defer_exit;           /* the start solve's only violation is a sliding mode failing at the
+                               step end (step.c, defer_exit) */
   int *bmode, *exit_mode;
   /* the last fesd__rows_active selection (solver, N, act, bmode, exit_mode), still in force
    * while rk_valid: the same selection is not rebuilt (rows_select clears rk_valid) */
