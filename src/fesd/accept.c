@@ -235,12 +235,14 @@ static int element_modes(const fesd_integrator *it, const double *z, int n, int 
   return c;
 }
 
-/* For implicit Euler: the modes of element n (c of them in out) and the one whose exit is
- * pinned at its end, whose theta is zero at the only stage (the sliding phase showed one element
- * short, or not at all). */
-static int euler_exit(const fesd_integrator *it, int n, int k, int *out, int c) {
+/* The modes of element n (c of them in out) and the one whose exit is pinned at its end: its
+ * theta falls to zero there, and in a short element it can lie below active_tol at every stage:
+ * implicit Euler (zero at its only stage) showed the sliding phase one element short or not at
+ * all; Gauss-Legendre s = 2 under error control (the exit-time check of error.c shortens the
+ * steps before an exit) logged an exit 3.6e-6 early, at the start of the element before it. */
+static int pinned_exit(const fesd_integrator *it, int n, int k, int *out, int c) {
   const int a = it->model.th_off[k], x = it->exit_mode[n + 1] - a;
-  if (!it->tab.c_end_is_one || it->bmode[n + 1] != 2 || x < 0 || x >= it->model.th_off[k + 1] - a) return c;
+  if (it->bmode[n + 1] != 2 || x < 0 || x >= it->model.th_off[k + 1] - a) return c;
   int p = 0; /* into the ascending list, once */
   while (p < c && out[p] < x) p++;
   if (p < c && out[p] == x) return c;
@@ -415,7 +417,8 @@ int fesd__accept(fesd_integrator *it, const double *z, const double *u, double T
   if (ambiguous_side(it, z)) it->step_flags |= FESD_FLAG_AMBIGUOUS;
   fesd__system_update_refs(S); /* the sizes of the last weighting: at z (step.c, solve) */
   if (it->set.sensitivities && (st = chain_sensitivities(it, z))) return st;
-  /* records */
+  /* records; the pinned exits of the one-stage methods and Gauss-Legendre (pinned_exit) */
+  const int pinned_modes = s == 1 || S->bp;
   double t = it->t;
   for (int n = 0; n < N; n++) {
     int e = it->n_el++;
@@ -438,9 +441,9 @@ int fesd__accept(fesd_integrator *it, const double *z, const double *u, double T
       if (n == 0 && !it->have_prev_theta && !it->start_jumped) continue;
       int nb = n > 0 ? element_modes(it, z, n - 1, k, b)
                : it->have_prev_theta ? active_modes(it, it->theta_prev, k, b) : flagged_modes(it, it->act_first, k, b);
-      if (n > 0 && s == 1) nb = euler_exit(it, n - 1, k, b, nb);
+      if (n > 0 && pinned_modes) nb = pinned_exit(it, n - 1, k, b, nb);
       int na = element_modes(it, z, n, k, b + nb);
-      if (s == 1) na = euler_exit(it, n, k, b + nb, na);
+      if (pinned_modes) na = pinned_exit(it, n, k, b + nb, na);
       add_event(it, t, k, b, nb, na, n);
     }
     t += z[S->ho[n]];

@@ -464,6 +464,9 @@ static int try_step(fesd_integrator *it, const double *u, double *T, fesd_step_i
     double err;
     if ((st = fesd__error_estimate(it, it->z, it->ec_rtol, it->err_atol, &err))) return st;
     info->error_estimate = fmax(info->error_estimate, err);
+    /* a direct error, not an embedded estimate of lower order: the user's tolerances */
+    if (S->bp && (st = fesd__exit_error(it, it->z, it->tol.rtol, it->tol_atol, &err))) return st;
+    info->error_estimate = fmax(info->error_estimate, err);
   } else if (it->set.coarse_tol > 0 && it->err_ok && (st = fesd__coarse_check(it, info))) {
     return st;
   }

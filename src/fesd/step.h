@@ -167,6 +167,10 @@ int fesd__error_setup(fesd_integrator *it);
 /* Local error estimate of the solution z of the current layout: weighted RMS norm of the
  * embedded difference with weights 1 / (atol_r + rtol max|x|), max over the elements. */
 int fesd__error_estimate(fesd_integrator *it, const double *z, double rtol, const double *atol, double *err);
+/* The time error of the step's pinned sliding exits and of a sliding mode that failed at the
+ * step end, from Filippov's conditions there, as a state error (the motion in that time) in the
+ * units of fesd__error_estimate. */
+int fesd__exit_error(fesd_integrator *it, const double *z, double rtol, const double *atol, double *err);
 /* FESD_FLAG_COARSE for the solution it->z of a fixed step: the estimate against coarse_tol, or
  * an element that outgrew its field (L-stable damping of a growing mode). */
 int fesd__coarse_check(fesd_integrator *it, fesd_step_info *info);
