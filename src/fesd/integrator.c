@@ -162,6 +162,7 @@ static void lay_out(fesd_integrator *it, const fesd_settings *settings, fesd__bl
     b->Sx = fesd__block_doubles(B, sx * sx);
     b->Su = fesd__block_doubles(B, sx * nu);
     b->ldp = fesd__block_doubles(B, settings->sensitivities ? nth * np : 1);
+    b->act = fesd__block_take(B, nth > 0 ? nth : 1, 0);
   }
   it->Sx = fesd__block_doubles(B, sx * sx);
   it->Su = fesd__block_doubles(B, sx * nu);
@@ -184,6 +185,7 @@ static void lay_out(fesd_integrator *it, const fesd_settings *settings, fesd__bl
   it->hlo = fesd__block_doubles(B, N);
   it->hhi = fesd__block_doubles(B, N);
   it->eq_active = fesd__block_take(B, (size_t)S->n_eq, 0);
+  it->act_prev = fesd__block_take(B, nth > 0 ? nth : 1, 0);
   it->pair_mode = fesd__block_take(B, (size_t)(S->n_pair > 0 ? S->n_pair : 1), 0);
   it->raw_border = fesd__block_take(B, (size_t)S->n_raw, 0);
   it->col_border = fesd__block_take(B, n, 0);
@@ -389,6 +391,7 @@ void fesd__save(fesd_integrator *it, fesd__saved *b) {
   memcpy(b->x, it->x, nx * sizeof(double));
   memcpy(b->lam, it->lam00, nth * sizeof(double));
   memcpy(b->th, it->theta_prev, nth * sizeof(double));
+  memcpy(b->act, it->act_prev, nth);
   memcpy(b->blk, it->ws_blk, (size_t)it->sys.sb * sizeof(double));
   if (!it->set.sensitivities) return; /* O(n_x^2) state only then */
   memcpy(b->Sx, it->Sx, nx * nx * sizeof(double));
@@ -408,6 +411,7 @@ void fesd__load(fesd_integrator *it, const fesd__saved *b) {
   memcpy(it->x, b->x, nx * sizeof(double));
   memcpy(it->lam00, b->lam, nth * sizeof(double));
   memcpy(it->theta_prev, b->th, nth * sizeof(double));
+  memcpy(it->act_prev, b->act, nth);
   memcpy(it->ws_blk, b->blk, (size_t)it->sys.sb * sizeof(double));
   if (!it->set.sensitivities) return;
   memcpy(it->Sx, b->Sx, nx * nx * sizeof(double));

@@ -62,6 +62,7 @@ typedef struct {
 
 typedef struct {
   double t, t_c, *x, *lam, *th, *blk, *Sx, *Su, *ldp;
+  unsigned char *act;
   int have_ws, have_prev_theta, n_el, n_events;
   int gn_warm; /* the stage Newton's choice of start (a retried step takes the same path) */
 } fesd__saved;
@@ -139,7 +140,9 @@ struct fesd_integrator {
   int full_check;   /* tests: always check the start solve on the whole step system (step.c) */
   long n_certified; /* start solves certified on their V rows (step.c), since fesd_create */
   int last_sw, last_iter; /* the last accepted step: a switch step?, its iterations (stats) */
-  int exit_pinned; /* the accepted sub-step's exits are pinned (exit rows on the plan path) */           /* the step started on a surface that the fields on both sides leave */
+  int exit_pinned; /* the accepted sub-step's exits are pinned (exit rows on the plan path) */
+  int plan_sets;   /* the accepted sub-step is a plan path solution: act holds its active sets */
+  unsigned char *act_prev; /* nth: the active set at the end of the last step (accept.c) */           /* the step started on a surface that the fields on both sides leave */
   /* the switch plan of the current (sub)step and the active set after each switch (rows of
    * nth flags; only the switch's subsystem is used) */
   fesd__switch *plan;

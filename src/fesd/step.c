@@ -455,6 +455,7 @@ static int try_step(fesd_integrator *it, const double *u, double *T, fesd_step_i
   /* Gauss-Legendre pins exits only on the plan path (exit_ext); the stiffly accurate methods'
    * last stage is the element end on either path */
   it->exit_pinned = it->set.exit_rows && !it->tab.is_explicit && (!S->bp || st_path_plan);
+  it->plan_sets = st_path_plan && it->set.method == FESD_METHOD_FESD;
   double ccm = 0;
   if (it->set.method == FESD_METHOD_FESD && info->fallback && (st = fesd__verify(it, it->z, &ccm)))
     return st;
@@ -465,7 +466,7 @@ static int try_step(fesd_integrator *it, const double *u, double *T, fesd_step_i
     if ((st = fesd__error_estimate(it, it->z, it->ec_rtol, it->err_atol, &err))) return st;
     info->error_estimate = fmax(info->error_estimate, err);
     /* a direct error, not an embedded estimate of lower order: the user's tolerances */
-    if (S->bp && (st = fesd__exit_error(it, it->z, it->tol.rtol, it->tol_atol, &err))) return st;
+    if ((st = fesd__exit_error(it, it->z, it->tol.rtol, it->tol_atol, &err))) return st;
     info->error_estimate = fmax(info->error_estimate, err);
   } else if (it->set.coarse_tol > 0 && it->err_ok && (st = fesd__coarse_check(it, info))) {
     return st;

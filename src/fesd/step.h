@@ -171,6 +171,13 @@ int fesd__error_estimate(fesd_integrator *it, const double *z, double rtol, cons
  * step end, from Filippov's conditions there, as a state error (the motion in that time) in the
  * units of fesd__error_estimate. */
 int fesd__exit_error(fesd_integrator *it, const double *z, double rtol, const double *atol, double *err);
+/* Whether subsystem k's sliding on modes i, j holds at the end of z's last element after mode
+ * `leave` falls below active_tol there: the other mode's Filippov margin above what the user's
+ * tolerances make of it (under error control). */
+int fesd__still_slides(fesd_integrator *it, const double *z, int i, int j, int leave, int *slides);
+/* theta at or below this is the solves' round-off (a pinned exit's theta = 0 is solved to
+ * newton_tol: it came out 1e-17 positive at a step end) */
+static inline double fesd__theta_floor(const fesd_integrator *it) { return 64.0 * it->newton_tol; }
 /* FESD_FLAG_COARSE for the solution it->z of a fixed step: the estimate against coarse_tol, or
  * an element that outgrew its field (L-stable damping of a growing mode). */
 int fesd__coarse_check(fesd_integrator *it, fesd_step_info *info);
