@@ -211,21 +211,34 @@ static int flagged_modes(const fesd_integrator *it, const unsigned char *a, int 
   return c;
 }
 
-/* ... and element n of z (active at any stage; under error control, for a plan path solution,
- * also a mode of a 2-mode sliding set of the solve whose theta is below active_tol but above
- * the solves' round-off: see end_set). */
-static int element_modes(const fesd_integrator *it, const double *z, int n, int k, int *out) {
+/* ... and element n of z under error control, for a plan path solution: also a mode of a
+ * 2-mode sliding set of the solve whose theta is below active_tol but above the solves'
+ * round-off (see end_set). */
+static int element_modes_kept(const fesd_integrator *it, const double *z, int n, int k, int *out) {
   const fesd__model *m = &it->model;
   const int s = it->s, sb = it->sys.sb, a = m->th_off[k], b = m->th_off[k + 1], nth = m->nth;
+  const double tol = it->set.active_tol, lo = fesd__theta_floor(it), *th = z + fesd__th(&it->sys, n, 0);
+  const unsigned char *A = it->act + (size_t)n * s * nth;
+  int j2, c = 0;
+  const int two = fesd__two_modes(m, A, k, &j2) >= 0;
+  for (int i = a; i < b; i++)
+    for (int j = 0; j < s; j++)
+      if (th[j * sb + i] > (two && A[j * nth + i] ? lo : tol)) {
+        out[c++] = i - a;
+        break;
+      }
+  return c;
+}
+
+/* ... and element n of z (active at any stage). */
+static int element_modes(const fesd_integrator *it, const double *z, int n, int k, int *out) {
+  const fesd__model *m = &it->model;
+  const int s = it->s, sb = it->sys.sb, a = m->th_off[k], b = m->th_off[k + 1];
   const double tol = it->set.active_tol, *th = z + fesd__th(&it->sys, n, 0); /* stage j: + j sb */
-  const unsigned char *A = it->ec_on && it->plan_sets ? it->act + (size_t)n * s * nth : NULL;
-  int j2;
-  if (A && fesd__two_modes(m, A, k, &j2) < 0) A = NULL;
-  const double lo = A ? fesd__theta_floor(it) : tol;
   int c = 0;
   for (int i = a; i < b; i++)
     for (int j = 0; j < s; j++)
-      if (th[j * sb + i] > (A && A[j * nth + i] ? lo : tol)) {
+      if (th[j * sb + i] > tol) {
         out[c++] = i - a;
         break;
       }
@@ -441,7 +454,7 @@ int fesd__accept(fesd_integrator *it, const double *z, const double *u, double T
   fesd__system_update_refs(S); /* the sizes of the last weighting: at z (step.c, solve) */
   if (it->set.sensitivities && (st = chain_sensitivities(it, z))) return st;
   /* records; the pinned exits of the one-stage methods and Gauss-Legendre (pinned_exit) */
-  const int pinned_modes = s == 1 || S->bp;
+  const int pinned_modes = s == 1 || S->bp, kept = it->ec_on && it->plan_sets; /* element_modes_kept */
   double t = it->t;
   for (int n = 0; n < N; n++) {
     int e = it->n_el++;
@@ -462,10 +475,10 @@ int fesd__accept(fesd_integrator *it, const double *z, const double *u, double T
        * any later step (otherwise nothing to compare: element 0's modes at any stage would
        * show a crossing inside element 0 of the standard method as an entry at t0) */
       if (n == 0 && !it->have_prev_theta && !it->start_jumped) continue;
-      int nb = n > 0 ? element_modes(it, z, n - 1, k, b)
+      int nb = n > 0 ? (kept ? element_modes_kept : element_modes)(it, z, n - 1, k, b)
                : flagged_modes(it, it->have_prev_theta ? it->act_prev : it->act_first, k, b);
       if (n > 0 && pinned_modes) nb = pinned_exit(it, n - 1, k, b, nb);
-      int na = element_modes(it, z, n, k, b + nb);
+      int na = (kept ? element_modes_kept : element_modes)(it, z, n, k, b + nb);
       if (pinned_modes) na = pinned_exit(it, n, k, b + nb, na);
       add_event(it, t, k, b, nb, na, n);
     }
@@ -477,7 +490,7 @@ int fesd__accept(fesd_integrator *it, const double *z, const double *u, double T
   if ((st = end_set(it, z, it->act_prev))) return st;
   for (int k = 0; k < nsys; k++) {
     int *b = event_room(it);
-    int nb = element_modes(it, z, N - 1, k, b);
+    int nb = (kept ? element_modes_kept : element_modes)(it, z, N - 1, k, b);
     add_event(it, it->t + T, k, b, nb, flagged_modes(it, it->act_prev, k, b + nb), -1);
   }
   it->rec_t[it->n_el] = it->t + T;

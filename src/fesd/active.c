@@ -92,7 +92,7 @@ static int resolve_ties(fesd_integrator *it, const double *u, unsigned char *a, 
 int fesd__act_start(fesd_integrator *it, const double *u, unsigned char *a, int *nonunique) {
   *nonunique = 0;
   if (it->have_prev_theta) {
-    memcpy(a, it->act_prev, (size_t)it->nth);
+    for (int i = 0; i < it->nth; i++) a[i] = it->act_prev[i]; /* a few bytes: no call */
     return FESD_OK;
   }
   fesd__model *m = &it->model;

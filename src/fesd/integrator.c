@@ -391,7 +391,7 @@ void fesd__save(fesd_integrator *it, fesd__saved *b) {
   memcpy(b->x, it->x, nx * sizeof(double));
   memcpy(b->lam, it->lam00, nth * sizeof(double));
   memcpy(b->th, it->theta_prev, nth * sizeof(double));
-  memcpy(b->act, it->act_prev, nth);
+  for (size_t i = 0; i < nth; i++) b->act[i] = it->act_prev[i]; /* a few bytes: no call */
   memcpy(b->blk, it->ws_blk, (size_t)it->sys.sb * sizeof(double));
   if (!it->set.sensitivities) return; /* O(n_x^2) state only then */
   memcpy(b->Sx, it->Sx, nx * nx * sizeof(double));
@@ -411,7 +411,7 @@ void fesd__load(fesd_integrator *it, const fesd__saved *b) {
   memcpy(it->x, b->x, nx * sizeof(double));
   memcpy(it->lam00, b->lam, nth * sizeof(double));
   memcpy(it->theta_prev, b->th, nth * sizeof(double));
-  memcpy(it->act_prev, b->act, nth);
+  for (size_t i = 0; i < nth; i++) it->act_prev[i] = b->act[i];
   memcpy(it->ws_blk, b->blk, (size_t)it->sys.sb * sizeof(double));
   if (!it->set.sensitivities) return;
   memcpy(it->Sx, b->Sx, nx * nx * sizeof(double));
