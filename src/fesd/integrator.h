@@ -142,6 +142,7 @@ struct fesd_integrator {
   int last_sw, last_iter; /* the last accepted step: a switch step?, its iterations (stats) */
   int exit_pinned; /* the accepted sub-step's exits are pinned (exit rows on the plan path) */
   int plan_sets;   /* the accepted sub-step is a plan path solution: act holds its active sets */
+  double exr_t0, exr_tb; /* start and exit time of the last exit the exit-time check rejected */
   unsigned char *act_prev; /* nth: the active set at the end of the last step (accept.c) */           /* the step started on a surface that the fields on both sides leave */
   /* the switch plan of the current (sub)step and the active set after each switch (rows of
    * nth flags; only the switch's subsystem is used) */

@@ -100,6 +100,24 @@ void fesd__poly_state(const fesd_integrator *it, const double *z, int n, const d
 #define START_REL 1e-6 /* distance to the surface, in units of the indicator scale */
 #define START_HIT 1e-3 /* arrival time, as a fraction of the first element */
 
+/* ... nor, under error control, a mode whose exit the log holds at this start (the last step
+ * ended on it: a stop condition or an output time at the exit, or accept.c's end_set): the
+ * fields at an exit are tangent, and the start check re-entered it, logging an entry and a
+ * second exit 4e-9 later (a stop condition at the exit; found by a review). */
+static int exited_at_start(const fesd_integrator *it, int k, int i) {
+  if (!it->ec_on) return 0;
+  const int mi = i - it->model.th_off[k];
+  for (int e = it->log_n - 1; e >= 0 && it->log[e].t >= it->sys.t0; e--) {
+    const fesd_event *v = &it->log[e];
+    if (v->sys != k || v->kind != FESD_EVENT_SLIDING_EXIT) continue;
+    int before = 0, after = 0;
+    for (int q = 0; q < v->n_before; q++) before |= v->before[q] == mi;
+    for (int q = 0; q < v->n_after; q++) after |= v->after[q] == mi;
+    return v->t == it->sys.t0 && before && !after;
+  }
+  return 0;
+}
+
 int fesd__scan_start(fesd_integrator *it, const double *z, const unsigned char *act, fesd__violation *ps) {
   fesd__system *S = &it->sys;
   fesd__model *m = &it->model;
@@ -110,6 +128,7 @@ int fesd__scan_start(fesd_integrator *it, const double *z, const unsigned char *
     if (act[i] || !(it->lam00[i] * S->wth[i] < START_REL)) continue;
     if (it->start_jumped && it->act_first[i] && !it->act0[i]) continue;
     const int k = m->sys_of[i], j = fesd__one_mode(m, act, k);
+    if (exited_at_start(it, k, i)) continue;
     if (j < 0) continue;
     const double *th = z + fesd__th(S, 0, 0);
     if (!evaluated) {
