@@ -143,3 +143,39 @@ double fesd__slide_cap(const fesd_integrator *it, double hh, const double *m_a, 
   }
   return cap;
 }
+
+/* Gauss-Legendre in a sliding element: its stage multipliers are not damped (|R(inf)| = 1), an
+ * inconsistency they carry grows like 1/h (index 2), and they alternate from stage to stage,
+ * which the b-weights cancel in the state but the embedded weights do not: the estimate stayed
+ * O(1) as h fell, and the run ended in FESD_ERR_STEP_TOO_SMALL while sliding (a curved surface,
+ * s = 2..4, every rtol from 1e-4 to 1e-10; the stage multipliers 0.40 / 0.40 at h = 1e-2, 4.4 /
+ * -3.6 at h = 1.3e-8; found by a review). There the estimate takes the field with Filippov's
+ * multipliers at each stage state (one model evaluation per stage): what the state's error
+ * depends on. *on = 0 when the element has no 2-mode sliding subsystem. */
+int fesd__consistent_stages(fesd_integrator *it, const double *z, int n, double tn, double h, double *acc,
+                            int *on) {
+  fesd__system *S = &it->sys;
+  const fesd__model *m = &it->model;
+  const int s = S->s, nx = S->nx, nth = S->nth;
+  *on = 0;
+  const unsigned char *a0 = it->act + (size_t)n * s * nth;
+  if (!fesd__any_two_modes(m, a0)) return FESD_OK;
+  const double *xn = n == 0 ? S->x0 : z + S->xo[n - 1];
+  double *X = it->gbuf + nth, *fc = it->ftot + 3 * nx;
+  for (int r = 0; r < nx; r++) acc[r] = 0;
+  for (int j = 0; j < s; j++) {
+    for (int r = 0; r < nx; r++) {
+      double q = 0;
+      for (int l = 0; l < s; l++) q += S->tab.A[j][l] * z[fesd__v(S, n, l) + r];
+      X[r] = xn[r] + h * q;
+    }
+    fesd__point_eval pe = fesd__scratch_eval(it);
+    int st = fesd__model_eval(&it->model, tn + S->tab.c[j] * h, X, S->u, &pe);
+    if (st) return st;
+    fesd__stage_theta(it, &pe, a0 + (size_t)j * nth, it->fil_th);
+    fesd__total_field(it, &pe, it->fil_th, fc);
+    for (int r = 0; r < nx; r++) acc[r] += it->err_e[j] * fc[r];
+  }
+  *on = 1;
+  return FESD_OK;
+}

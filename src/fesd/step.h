@@ -171,6 +171,10 @@ int fesd__error_estimate(fesd_integrator *it, const double *z, double rtol, cons
  * step end, from Filippov's conditions there, as a state error (the motion in that time) in the
  * units of fesd__error_estimate. */
 int fesd__exit_error(fesd_integrator *it, const double *z, double rtol, const double *atol, double *err);
+/* For the estimate of a sliding element n of Gauss-Legendre (graze.c): acc = sum_j e_j (the field
+ * with Filippov's multipliers at stage state j); *on = 0 when no subsystem slides there. */
+int fesd__consistent_stages(fesd_integrator *it, const double *z, int n, double tn, double h, double *acc,
+                            int *on);
 /* Whether subsystem k's sliding on modes i, j holds at the end of z's last element after mode
  * `leave` falls below active_tol there: the other mode's Filippov margin above what the user's
  * tolerances make of it (under error control). */
