@@ -138,8 +138,25 @@ double fesd__graze_dip(const fesd_integrator *it, double hh, const double *lam_a
 double fesd__slide_cap(const fesd_integrator *it, double hh, const double *m_a, const double *m_b) {
   double cap = INFINITY;
   for (int k = 0; k < it->model.nsys; k++) {
-    if (!(m_b[k] > 0 && m_a[k] > m_b[k])) continue; /* NaN: not sliding at one end */
-    cap = fmin(cap, 1.5 * hh * m_b[k] / (m_a[k] - m_b[k]));
+    if (m_b[k] > 0 && m_a[k] > m_b[k]) cap = fmin(cap, 1.5 * hh * m_b[k] / (m_a[k] - m_b[k]));
+    /* the margin can turn: a stuck phase of a forced stick-slip oscillator whose margin rose
+     * over the last steps and dipped below zero inside the next one (a slip of 0.66 inside a
+     * step of 5.5, Radau IIA s = 3, rtol 1e-9: x(30) 1.3e4 tolerances off, FESD_OK; found by a
+     * review). The parabola through the margins at the last three step ends (the accepted
+     * step before this one too): the next step ends shortly after its first zero */
+    const double h2 = it->ap_h2, m2 = it->ap_m2[k];
+    if (!(h2 > 0) || !(m2 > 0 && m_a[k] > 0 && m_b[k] > 0)) continue;
+    /* m(t) = m_b + b t + c t^2, t from the step end; the points t = -hh (m_a), -hh - h2 (m2) */
+    const double d1 = (m_b[k] - m_a[k]) / hh, d2 = (m_a[k] - m2) / h2, c = (d1 - d2) / (hh + h2);
+    const double b = d1 + c * hh; /* m'(0) */
+    if (!(c < 0) && !(b < 0)) continue;
+    const double D = b * b - 4 * c * m_b[k];
+    if (c == 0 || D < 0) continue;
+    const double q = -0.5 * (b + copysign(sqrt(D), b)), r1 = q / c, r2 = q != 0 ? m_b[k] / q : INFINITY;
+    double t0 = INFINITY;
+    if (r1 > 0) t0 = r1;
+    if (r2 > 0 && r2 < t0) t0 = r2;
+    if (isfinite(t0)) cap = fmin(cap, 1.1 * t0);
   }
   return cap;
 }

@@ -347,6 +347,7 @@ static int integrate(fesd_integrator *it, const double *u, double t_out, fesd_in
   /* the graze check's values at the start: again on every call (u or the callbacks' data may
    * have changed since the last one at this time) */
   it->ap_t = NAN;
+  it->ap_h2 = NAN; /* no margin history (fesd__slide_cap) */
   /* the controller's memory (it->ec_rejected, it->ec_err_prev) lives in the integrator: one
    * call or many (fesd_integrate_grid steps one at a time) take the same steps */
   while (it->t < t_out) {
@@ -407,6 +408,8 @@ static int integrate(fesd_integrator *it, const double *u, double t_out, fesd_in
       continue;
     }
     const double cap = fesd__slide_cap(it, hh, it->ap_m, it->ap_m_b);
+    memcpy(it->ap_m2, it->ap_m, (size_t)it->nsys * sizeof(double));
+    it->ap_h2 = hh;
     memcpy(it->ap_m, it->ap_m_b, (size_t)it->nsys * sizeof(double));
     memcpy(it->ap_lam, it->ap_lam_b, (size_t)it->nth * sizeof(double));
     memcpy(it->ap_rate, it->ap_rate_b, (size_t)it->nth * sizeof(double));

@@ -146,6 +146,7 @@ static void lay_out(fesd_integrator *it, const fesd_settings *settings, fesd__bl
   it->ap_th = fesd__block_doubles(B, nth);
   it->ap_m = fesd__block_doubles(B, nsys);
   it->ap_m_b = fesd__block_doubles(B, nsys);
+  it->ap_m2 = fesd__block_doubles(B, nsys);
   it->u_cur = fesd__block_doubles(B, nu);
   it->ws_blk = fesd__block_doubles(B, (size_t)S->sb);
   it->z = fesd__block_doubles(B, n);
@@ -212,6 +213,7 @@ static void lay_out(fesd_integrator *it, const fesd_settings *settings, fesd__bl
   it->herm = fesd__block_doubles(B, 2 * nth);
   it->fil_mi = fesd__block_doubles(B, nsys * s);
   it->fil_mj = fesd__block_doubles(B, nsys * s);
+  it->fil_pm = fesd__block_doubles(B, 2 * nsys);
   it->slide_tmp = fesd__block_doubles(B, 2 * nx);
   it->fil_a = fesd__block_take(B, nth, 0);
   fesd__point_take(&it->model, &it->pscr, 1, B);

@@ -89,6 +89,7 @@ struct fesd_integrator {
    * and at its end (b), per mode; ap_th scratch thetas; ap_t: the time the (a) values hold at */
   double *ap_lam, *ap_rate, *ap_lam_b, *ap_rate_b, *ap_th, ap_t;
   double *ap_m, *ap_m_b; /* nsys: Filippov margins of the sliding subsystems at both step ends */
+  double *ap_m2, ap_h2;  /* ... at the start of the accepted step before, and its length (NaN) */
   int have_state, have_ws, have_prev_theta;
   /* step data (sized for N_cap elements) */
   double *z, *z0, *zpred, *zp;
@@ -108,6 +109,7 @@ struct fesd_integrator {
   double *fil_th;         /* nth: multipliers of an alternative (verify.c) */
   double *herm;           /* 2 nth: distance and rate of each mode at an element start (verify_between.c) */
   double *fil_mi, *fil_mj; /* nsys s: normalised normal components at the stages (verify.c) */
+  double *fil_pm;          /* 2 nsys: ... at the previous element's end (its last stage, c_s = 1) */
   double *slide_tmp;      /* 2 nx: the coupled sliding multipliers (fesd__stage_theta) */
   unsigned char *fil_a;   /* nth: its active flags */
   int *gn_piv;
