@@ -330,28 +330,30 @@ static int scan_filippov(fesd_integrator *it, const double *z, const unsigned ch
   for (int n = 0; n < S->N; n++) {
     const double h = z[S->ho[n]];
     const unsigned char *a = act + (size_t)(n * s) * nth;
-    /* the last stage's margins of the element before, if it slid and no subsystem switched at
-     * the boundary between (another's switch makes the multipliers jump there) */
-    const int same = slid && S->tab.c[s - 1] == 1.0 && !memcmp(a - (size_t)nth, a, (size_t)nth);
-    for (int k = 0; k < m->nsys; k++) {
-      it->fil_pm[2 * k] = same ? it->fil_mi[k * s + s - 1] : NAN;
-      it->fil_pm[2 * k + 1] = same ? it->fil_mj[k * s + s - 1] : NAN;
-    }
-    /* the step start, the last step's last stage (c_s = 1) with the same sets: its multipliers
-     * (a stuck phase of 5.5 in one step, Radau IIA s = 3, whose stick condition failed between
-     * the stages of its first element: a slip of 0.66 missed, x(30) 1.3e3 tolerances off) */
-    if (n == 0 && it->have_prev_theta && S->tab.c[s - 1] == 1.0 && S->tab.c[0] > 0 && fesd__any_two_modes(m, a) &&
-        !memcmp(it->act0, a, (size_t)nth)) {
-      int st = fesd__model_eval(m, S->t0, S->x0, S->u, &pe);
-      if (st) return st;
-      fesd__total_field(it, &pe, it->theta_prev, it->ftot);
+    if (!fesd__any_two_modes(m, a)) {
+      slid = 0;
+    } else {
+      /* the last stage's margins of the element before, if it slid and no subsystem switched at
+       * the boundary between (another's switch makes the multipliers jump there) */
+      const int same = slid && S->tab.c[s - 1] == 1.0 && !memcmp(a - (size_t)nth, a, (size_t)nth);
       for (int k = 0; k < m->nsys; k++) {
-        int j, i = fesd__two_modes(m, a, k, &j);
-        if (i >= 0) fesd__sliding_margins(it, &pe, it->theta_prev, it->ftot, i, j, it->fil_pm + 2 * k, it->fil_pm + 2 * k + 1);
+        it->fil_pm[2 * k] = same ? it->fil_mi[k * s + s - 1] : NAN;
+        it->fil_pm[2 * k + 1] = same ? it->fil_mj[k * s + s - 1] : NAN;
       }
-    }
-    slid = 0;
-    if (fesd__any_two_modes(m, a)) {
+      /* the step start, the last step's last stage (c_s = 1) with the same sets: its multipliers
+       * (a stuck phase of 5.5 in one step, Radau IIA s = 3, whose stick condition failed between
+       * the stages of its first element: a slip of 0.66 missed, x(30) 1.3e3 tolerances off) */
+      if (n == 0 && it->have_prev_theta && S->tab.c[s - 1] == 1.0 && S->tab.c[0] > 0 &&
+          !memcmp(it->act0, a, (size_t)nth)) {
+        int st = fesd__model_eval(m, S->t0, S->x0, S->u, &pe);
+        if (st) return st;
+        fesd__total_field(it, &pe, it->theta_prev, it->ftot);
+        for (int k = 0; k < m->nsys; k++) {
+          int j, i = fesd__two_modes(m, a, k, &j);
+          if (i >= 0)
+            fesd__sliding_margins(it, &pe, it->theta_prev, it->ftot, i, j, it->fil_pm + 2 * k, it->fil_pm + 2 * k + 1);
+        }
+      }
       slid = 1;
       for (int q = 0; q < m->nsys * s; q++) it->fil_mi[q] = it->fil_mj[q] = NAN;
       for (int q = 0; q < s; q++) {
