@@ -83,7 +83,7 @@ static inline int estimate(fesd_integrator *it, const double *z, double rtol, co
   for (int n = 0; n < S->N; n++) {
     const double h = z[S->ho[n]], *xn = n == 0 ? S->x0 : z + S->xo[n - 1], *x1 = z + S->xo[n];
     int use_cons = 0;
-    if (bp && !S->tab.is_explicit) {
+    if (bp) {
       int st = fesd__consistent_stages(it, z, n, tn, h, cons, &use_cons);
       if (st) return st;
     }
@@ -138,19 +138,6 @@ int fesd__error_estimate(fesd_integrator *it, const double *z, double rtol, cons
   return it->sys.bp ? estimate(it, z, rtol, atol, err, 1) : estimate(it, z, rtol, atol, err, 0);
 }
 
-/* Subsystems sliding on two modes in the active set a. With two or more their multipliers are
- * coupled (a co-dimension-2 sliding mode), and one subsystem's 2-mode margin with the others'
- * multipliers held is not its own: measured, the exit-time check on such margins took 66136
- * steps instead of 984 (a randomised property test of piecewise-affine systems). */
-static int sliding_count(const fesd__model *m, const unsigned char *a) {
-  int c = 0;
-  for (int k = 0; k < m->nsys; k++) {
-    int j;
-    c += fesd__two_modes(m, a, k, &j) >= 0;
-  }
-  return c;
-}
-
 /* Both Filippov margins (fesd__sliding_margins) of subsystem k sliding on modes i, j in element
  * kb - 1, at its end (p = 0), its start (p = 1), or its end moved by the tolerance of each
  * component (p = 2: all up; p = 3: alternating), from a fresh evaluation unless `fresh` is 0
@@ -202,7 +189,22 @@ static int margins_at(fesd_integrator *it, const double *z, int kb, double tb, i
  * stage's multiplier, off by its order (Radau IIA s = 2 at rtol 1e-11 on a curved surface:
  * 1.7e-8 at first, 7.6e-10 accepted before). Shorter steps before an exit leave the leaving
  * mode's theta below active_tol at a step end, which no longer drops the mode (accept.c,
- * end_set). One sliding subsystem at a time (sliding_count). */
+ * end_set). One sliding subsystem at a time. */
+/* What the state's own tolerance makes of the staying mode's margin m0 at the end of element
+ * kb - 1: its largest change when the end point moves by the tolerance of each component (two
+ * directions). A margin within it is as exact as the state. */
+static int margin_noise(fesd_integrator *it, const double *z, int kb, double tb, int i, int j, int stay_i, double m0,
+                        double rtol, const double *atol, double *noise) {
+  *noise = 0;
+  for (int p = 2; p <= 3; p++) {
+    double mi, mj, v;
+    int st = margins_at(it, z, kb, tb, p, 1, i, j, rtol, atol, &mi, &mj, &v);
+    if (st) return st;
+    *noise = fesd__fmax(*noise, fabs((stay_i ? mi : mj) - m0));
+  }
+  return FESD_OK;
+}
+
 int fesd__exit_error(fesd_integrator *it, const double *z, double rtol, const double *atol, double *err) {
   fesd__system *S = &it->sys;
   const fesd__model *m = &it->model;
@@ -213,7 +215,10 @@ int fesd__exit_error(fesd_integrator *it, const double *z, double rtol, const do
     const int end = kb == S->N;
     if (!end && it->bmode[kb] != 2) continue;
     const unsigned char *a = it->act + (size_t)((kb - 1) * S->s + S->s - 1) * S->nth;
-    if (sliding_count(m, a) != 1) continue; /* coupled multipliers: the margins are not k's own */
+    /* with two or more sliding subsystems their multipliers are coupled (a co-dimension-2
+     * sliding mode): one subsystem's 2-mode margin with the others' held is not its own
+     * (measured: the check on such margins took 66136 steps instead of 984, prop_integrate) */
+    if (fesd__count_two_modes(m, a) != 1) continue;
     int fresh = 1;
     for (int k = 0; k < m->nsys; k++) {
       int j, i = fesd__two_modes(m, a, k, &j);
@@ -233,16 +238,13 @@ int fesd__exit_error(fesd_integrator *it, const double *z, double rtol, const do
       /* the margin falls to its zero at the exit: a linear fit through both points */
       const double h = z[S->ho[kb - 1]], rate = (m0 - m1) / h;
       if (!(rate < 0) || !isfinite(m0)) continue;
-      /* what the state's own tolerance makes of the margin there (two directions): an exit
-       * within it is as exact as the state. Measured in an experiment that kept sliding modes
-       * with theta below active_tol across step ends: Gauss s = 2 at rtol 1e-9 retried an exit
-       * 6e-10 off at the end of a sliding element of 2.9e-7, which shorter steps did not
-       * change, until FESD_ERR_STEP_TOO_SMALL. */
-      double noise = 0;
-      for (int p = 2; p <= 3; p++) {
-        if ((st = margins_at(it, z, kb, tb, p, 1, i, j, rtol, atol, &mi, &mj, &v))) return st;
-        noise = fesd__fmax(noise, fabs((stay_i ? mi : mj) - m0));
-      }
+      /* an exit within what the state's tolerance makes of the margin is as exact as the
+       * state. Measured in an experiment that kept sliding modes with theta below active_tol
+       * across step ends: Gauss s = 2 at rtol 1e-9 retried an exit 6e-10 off at the end of a
+       * sliding element of 2.9e-7, which shorter steps did not change, until
+       * FESD_ERR_STEP_TOO_SMALL. */
+      double noise;
+      if ((st = margin_noise(it, z, kb, tb, i, j, stay_i, m0, rtol, atol, &noise))) return st;
       const double dt = fesd__fmax(fabs(m0) - noise, 0.0) / -rate;
       /* A pinned exit off by more than its sliding element is long: a shorter step does not
        * move it (Gauss-Legendre's multipliers are not damped, |R(inf)| = 1, and carry an error
@@ -268,21 +270,18 @@ int fesd__exit_error(fesd_integrator *it, const double *z, double rtol, const do
 
 int fesd__still_slides(fesd_integrator *it, const double *z, int i, int j, int leave, int *slides) {
   fesd__system *S = &it->sys;
-  if (sliding_count(&it->model, it->act + (size_t)(S->N * S->s - 1) * S->nth) != 1) {
+  if (fesd__count_two_modes(&it->model, it->act + (size_t)(S->N * S->s - 1) * S->nth) != 1) {
     *slides = 0; /* as fesd__exit_error */
     return FESD_OK;
   }
   const double tb = S->t0 + S->T, rtol = it->tol.rtol, *atol = it->tol_atol;
   const int stay_i = leave != i;
-  double mi, mj, v, m0, noise = 0;
+  double mi, mj, v, noise = 0;
   *slides = 0;
   int st = margins_at(it, z, S->N, tb, 0, 1, i, j, rtol, atol, &mi, &mj, &v);
   if (st) return st;
-  m0 = stay_i ? mi : mj;
-  for (int p = 2; p <= 3 && m0 > 0; p++) {
-    if ((st = margins_at(it, z, S->N, tb, p, 1, i, j, rtol, atol, &mi, &mj, &v))) return st;
-    noise = fesd__fmax(noise, fabs((stay_i ? mi : mj) - m0));
-  }
+  const double m0 = stay_i ? mi : mj;
+  if (m0 > 0 && (st = margin_noise(it, z, S->N, tb, i, j, stay_i, m0, rtol, atol, &noise))) return st;
   *slides = m0 > noise;
   return FESD_OK;
 }

@@ -177,15 +177,10 @@ int fesd__consistent_stages(fesd_integrator *it, const double *z, int n, double 
   *on = 0;
   const unsigned char *a0 = it->act + (size_t)n * s * nth;
   if (!fesd__any_two_modes(m, a0)) return FESD_OK;
-  const double *xn = n == 0 ? S->x0 : z + S->xo[n - 1];
   double *X = it->gbuf + nth, *fc = it->ftot + 3 * nx;
   for (int r = 0; r < nx; r++) acc[r] = 0;
   for (int j = 0; j < s; j++) {
-    for (int r = 0; r < nx; r++) {
-      double q = 0;
-      for (int l = 0; l < s; l++) q += S->tab.A[j][l] * z[fesd__v(S, n, l) + r];
-      X[r] = xn[r] + h * q;
-    }
+    fesd__stage_state(S, z, n, j, X);
     fesd__point_eval pe = fesd__scratch_eval(it);
     int st = fesd__model_eval(&it->model, tn + S->tab.c[j] * h, X, S->u, &pe);
     if (st) return st;

@@ -134,7 +134,7 @@ struct fesd_integrator {
                               mode left), or -1 */
   fesd__violation *scan_buf; /* nsys */
   int step_flags;          /* FESD_FLAG_* of the current fesd_step */
-  int nonunique;
+  int nonunique; /* the step started on a surface that the fields on both sides leave */
   /* guess_fixed: the last fesd__consistent_guess solved every element's stage equations by
    * stage Newton (its result is then a fixed point of it); z0_fixed: so did the one that made
    * z0 in fesd__initial_guess (start_solve need not repeat it on an unchanged z0) */
@@ -145,7 +145,7 @@ struct fesd_integrator {
   int exit_pinned; /* the accepted sub-step's exits are pinned (exit rows on the plan path) */
   int plan_sets;   /* the accepted sub-step is a plan path solution: act holds its active sets */
   double exr_t0, exr_tb; /* start and exit time of the last exit the exit-time check rejected */
-  unsigned char *act_prev; /* nth: the active set at the end of the last step (accept.c) */           /* the step started on a surface that the fields on both sides leave */
+  unsigned char *act_prev; /* nth: the active set at the end of the last step (accept.c) */
   /* the switch plan of the current (sub)step and the active set after each switch (rows of
    * nth flags; only the switch's subsystem is used) */
   fesd__switch *plan;

@@ -312,3 +312,9 @@ int fesd__any_two_modes(const fesd__model *m, const unsigned char *a) {
     if (fesd__two_modes(m, a, k, &j) >= 0) return 1;
   return 0;
 }
+
+int fesd__count_two_modes(const fesd__model *m, const unsigned char *a) {
+  int j, c = 0;
+  for (int k = 0; k < m->nsys; k++) c += fesd__two_modes(m, a, k, &j) >= 0;
+  return c;
+}

@@ -70,6 +70,8 @@ int fesd__model_g(fesd__model *m, double t, const double *x, const double *u, do
 int fesd__two_modes(const fesd__model *m, const unsigned char *a, int k, int *j);
 /* Whether some subsystem has exactly two active modes in a (a 2-mode sliding mode). */
 int fesd__any_two_modes(const fesd__model *m, const unsigned char *a);
+/* How many subsystems have exactly two active modes in a. */
+int fesd__count_two_modes(const fesd__model *m, const unsigned char *a);
 /* The active mode of subsystem k when exactly one is active in a, else -1. */
 static inline int fesd__one_mode(const fesd__model *m, const unsigned char *a, int k) {
   int j = -1, cnt = 0;

@@ -10,6 +10,15 @@ static const double *elem_start(const fesd__system *S, const double *z, int n) {
   return n == 0 ? S->x0 : z + S->xo[n - 1];
 }
 
+void fesd__stage_state(const fesd__system *S, const double *z, int n, int j, double *X) {
+  const double *xn = elem_start(S, z, n), h = z[S->ho[n]];
+  for (int r = 0; r < S->nx; r++) {
+    double acc = 0;
+    for (int l = 0; l < S->s; l++) acc += S->tab.A[j][l] * z[fesd__v(S, n, l) + r];
+    X[r] = xn[r] + h * acc;
+  }
+}
+
 /* Look-ahead term of element n's first stage (X = x_n, pe evaluated there with grad g):
  * LK = kappa h grad g . v_1; with want_jac also its derivatives: d/dh (KG), d/dx_n = grad g +
  * kappa h H v_1 (dgl; H v_1 by a forward difference of the switch Jacobian along v_1, exact

@@ -160,6 +160,8 @@ const double *fesd__left_lambda(const fesd__system *S, const double *z, int n);
 /* Evaluate the model at every stage point (and boundary LP point) of z, with Jacobians when
  * want_jac (fills pe, X, Jth; JK and KG when a Jacobian asks for them). */
 int fesd__system_points(fesd__system *S, const double *z, int want_jac);
+/* The state at stage j of element n of z: x_n + h sum_l a_jl v_l (nx values into X). */
+void fesd__stage_state(const fesd__system *S, const double *z, int n, int j, double *X);
 /* JK and KG (the h column of the stage rows) of the points of the last fesd__system_points
  * with Jacobians; until then JK holds K_j. */
 void fesd__system_points_hcol(fesd__system *S);

@@ -279,12 +279,7 @@ static void interp_margins(fesd_integrator *it, const unsigned char *a, int n, d
   const fesd__system *S = &it->sys;
   const fesd__model *m = &it->model;
   const int s = S->s;
-  int sliding = 0;
-  for (int k = 0; k < m->nsys && sliding < 2; k++) {
-    int j;
-    sliding += fesd__two_modes(m, a, k, &j) >= 0;
-  }
-  if (sliding != 1 || s < 2) return;
+  if (fesd__count_two_modes(m, a) != 1 || s < 2) return;
   for (int k = 0; k < m->nsys; k++) {
     int j, i = fesd__two_modes(m, a, k, &j);
     if (i < 0) continue;
@@ -359,12 +354,7 @@ static int scan_filippov(fesd_integrator *it, const double *z, const unsigned ch
       for (int q = 0; q < s; q++) {
         if (S->tab.c[q] == 0.0 && n > 0) continue; /* the element start: checked before */
         double *X = it->gbuf + nth;
-        const double *xn = n == 0 ? S->x0 : z + S->xo[n - 1];
-        for (int r = 0; r < S->nx; r++) {
-          double acc = 0;
-          for (int l = 0; l < s; l++) acc += S->tab.A[q][l] * z[fesd__v(S, n, l) + r];
-          X[r] = xn[r] + h * acc;
-        }
+        fesd__stage_state(S, z, n, q, X);
         int st = fesd__model_eval(m, S->t0 + tn + S->tab.c[q] * h, X, S->u, &pe);
         if (st) return st;
         const double *th = z + fesd__th(S, n, q);
