@@ -135,6 +135,8 @@ double fesd__graze_dip(const fesd_integrator *it, double hh, const double *lam_a
  * between check points (measured: a forced stick-slip oscillator, Lobatto IIIC s = 2 at rtol
  * 1e-6, a short slip missed; the higher-order families by the midpoint check's allowance). The
  * step may pass the predicted zero (no Zeno-like approach), its stage checks then see it. */
+#define SLIDE_CUBIC 0.1
+#define SLIDE_YOUNG 2.0
 double fesd__slide_cap(const fesd_integrator *it, double hh, const double *m_a, const double *m_b) {
   double cap = INFINITY;
   for (int k = 0; k < it->model.nsys; k++) {
@@ -144,10 +146,24 @@ double fesd__slide_cap(const fesd_integrator *it, double hh, const double *m_a, 
      * step of 5.5, Radau IIA s = 3, rtol 1e-9: x(30) 1.3e4 tolerances off, FESD_OK; found by a
      * review). The parabola through the margins at the last three step ends (the accepted
      * step before this one too): the next step ends shortly after its first zero */
-    const double h2 = it->ap_h2, m2 = it->ap_m2[k];
+    const double h2 = it->ap_h2, m2 = it->ap_m2[k], h3 = it->ap_h3, m3 = it->ap_m3[k];
+    /* until four step ends of the sliding mode give its margin a model (below), the steps grow
+     * by SLIDE_YOUNG at most: after an entry, steps of 0.23, 1.15 and 5.7 (growth 5) went over a
+     * slip of 0.66 (the same stuck phase, Radau IIA s = 3, rtol 1e-6: x(30) 13 tolerances off) */
+    if (m_b[k] > 0 && !(m_a[k] > 0 && h2 > 0 && m2 > 0 && h3 > 0 && m3 > 0)) cap = fmin(cap, SLIDE_YOUNG * hh);
     if (!(h2 > 0) || !(m2 > 0 && m_a[k] > 0 && m_b[k] > 0)) continue;
     /* m(t) = m_b + b t + c t^2, t from the step end; the points t = -hh (m_a), -hh - h2 (m2) */
     const double d1 = (m_b[k] - m_a[k]) / hh, d2 = (m_a[k] - m2) / h2, c = (d1 - d2) / (hh + h2);
+    /* the parabola models the margin over the next step only while the margin's cubic term
+     * stays small against it: |m'''| h^3 / 6 <= SLIDE_CUBIC m_b, m''' / 6 the third divided
+     * difference of the margins at the last four step ends. A stuck phase whose margin had
+     * risen to its maximum (the parabola opened upwards) took a step of 6.3 (growth 5; the
+     * margin's period 13) over a slip of 0.66 (Gauss-Legendre s = 2, rtol 1e-8: x(30) 1.3e3
+     * tolerances off, FESD_OK; found by a review) */
+    if (h3 > 0 && m3 > 0) {
+      const double d3 = (m2 - m3) / h3, e2 = (d2 - d3) / (h2 + h3), f = (c - e2) / (hh + h2 + h3);
+      if (f != 0) cap = fmin(cap, cbrt(SLIDE_CUBIC * m_b[k] / fabs(f)));
+    }
     const double b = d1 + c * hh; /* m'(0) */
     if (!(c < 0) && !(b < 0)) continue;
     const double D = b * b - 4 * c * m_b[k];

@@ -147,6 +147,7 @@ static void lay_out(fesd_integrator *it, const fesd_settings *settings, fesd__bl
   it->ap_m = fesd__block_doubles(B, nsys);
   it->ap_m_b = fesd__block_doubles(B, nsys);
   it->ap_m2 = fesd__block_doubles(B, nsys);
+  it->ap_m3 = fesd__block_doubles(B, nsys);
   it->u_cur = fesd__block_doubles(B, nu);
   it->ws_blk = fesd__block_doubles(B, (size_t)S->sb);
   it->z = fesd__block_doubles(B, n);
@@ -169,7 +170,8 @@ static void lay_out(fesd_integrator *it, const fesd_settings *settings, fesd__bl
   it->Su = fesd__block_doubles(B, sx * nu);
   it->Dtmp = fesd__block_doubles(B, settings->sensitivities ? (nx > nth ? nx : nth) * np : 1);
   it->Stmp = fesd__block_doubles(B, settings->sensitivities ? nx * (nx > nu ? nx : nu) : 1);
-  it->gbuf = fesd__block_doubles(B, nth + (size_t)(FESD_RK_MAX_STAGES + 1) * nx); /* + the midpoint states */
+  /* + the midpoint states and indicators */
+  it->gbuf = fesd__block_doubles(B, nth + (size_t)(FESD_RK_MAX_STAGES + 1) * (nx + nth));
   it->blk = fesd__block_doubles(B, (size_t)S->sb);
   it->vtmp = fesd__block_doubles(B, 2 * nx);
   it->ftot = fesd__block_doubles(B, 4 * nx); /* total field; first_step: two more states, weights */
@@ -371,6 +373,7 @@ int fesd_set_state(fesd_integrator *it, double t0, const double *x0, const doubl
   memset(it->stop_dir, 0, (size_t)it->nsys);
   it->last_stop_t = NAN;
   it->ap_t = NAN;
+  it->ap_h2 = it->ap_h3 = NAN; /* no margin history (fesd__slide_cap) */
   it->ec_rejected = 0;
   it->ec_err_prev = 0;
   it->log_pool_n = 0;
@@ -439,6 +442,7 @@ int fesd_step(fesd_integrator *it, const double *u, double T, fesd_step_info *in
   for (int i = 0; i < it->nu; i++)
     if (!isfinite(u[i])) return info->status = FESD_ERR_INVALID_ARG;
   double t0 = fesd__wall_time();
+  if (!it->ec_on) it->ap_h2 = it->ap_h3 = NAN; /* a step outside error control: no margin history */
   it->n_el = 0;
   it->n_events = 0;
   fesd__save(it, &it->bk);

@@ -52,6 +52,8 @@ typedef struct {
                    the mode whose field points into its own region (-1: both: repulsive) */
   double lo, hi; /* bracket of the switch: the last point seen on the right side, the point
                     where the sign was violated (the trajectory agrees up to the switch) */
+  double back;    /* an excursion between check points (verify_between.c): the time the
+                     trajectory turns back (NaN or 0: none) */
 } fesd__violation;
 
 /* A saved state (integrator.c): the step start, restored when fesd_step fails, and the start
@@ -90,6 +92,7 @@ struct fesd_integrator {
   double *ap_lam, *ap_rate, *ap_lam_b, *ap_rate_b, *ap_th, ap_t;
   double *ap_m, *ap_m_b; /* nsys: Filippov margins of the sliding subsystems at both step ends */
   double *ap_m2, ap_h2;  /* ... at the start of the accepted step before, and its length (NaN) */
+  double *ap_m3, ap_h3;  /* ... and of the one before that */
   int have_state, have_ws, have_prev_theta;
   /* step data (sized for N_cap elements) */
   double *z, *z0, *zpred, *zp;
@@ -171,6 +174,10 @@ struct fesd_integrator {
   double mid_w[(FESD_RK_MAX_STAGES + 1) * FESD_RK_MAX_STAGES];
   double mid_tau[FESD_RK_MAX_STAGES + 1];
   int mid_stage[FESD_RK_MAX_STAGES + 1]; /* the stage nearest to each midpoint */
+  /* the excursion check's nodes in time order: 0 (the element start), the stages (c_j > 0: at
+   * exc_stage[j] >= 1, else -1) and the midpoints (at exc_mid[p]); exc_tau their times */
+  int n_exc, exc_stage[FESD_RK_MAX_STAGES], exc_mid[FESD_RK_MAX_STAGES + 1]; /* positions in: */
+  double exc_tau[2 * FESD_RK_MAX_STAGES + 2];
   /* error estimate (error.c): embedded weights (e0 on the field at the element start, e_j on
    * the stages), order of the estimate */
   int err_ok, err_q;

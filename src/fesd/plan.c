@@ -436,6 +436,21 @@ static int update_one(fesd_integrator *it, const double *z, const fesd__violatio
   w->hi = jump ? T : v->hi;
   memcpy(after(it, it->n_plan) + a, ns + a, (size_t)(b - a));
   it->n_plan++;
+  /* An excursion into a region whose field pushes back (the entry slides): the sliding mode
+   * ends about where the trajectory turned back (the staying mode's field is tangent there
+   * again), so its exit is planned with the entry. Alone, the entry's plan slid to the step
+   * end, which has no solution, and the step fell back to the FB path, which stepped over it
+   * (a touch x1 = d - (t - 1)^2 / 2 with d = 1e-5, Radau IIA s = 3, h = 0.375: x1(1.5) off by
+   * d, FESD_OK). */
+  int jo;
+  if (v->enter && v->back > t_new && v->back < T && can_pin_exit(it) && fesd__two_modes(m, ns, k, &jo) >= 0) {
+    if (it->n_plan >= it->cap_plan) return FESD_ERR_TOO_MANY_SWITCHES;
+    fesd__switch *x = &it->plan[it->n_plan];
+    *x = *w;
+    x->t = v->back, x->mode = v->mode, x->exit = 1, x->lo = t_new, x->hi = T;
+    memcpy(after(it, it->n_plan) + a, P + a, (size_t)(b - a));
+    it->n_plan++;
+  }
   return 1;
 }
 

@@ -306,7 +306,7 @@ static void interp_margins(fesd_integrator *it, const unsigned char *a, int n, d
       }
       const int bi = vi < -FIL_INTERP_TOL, bj = vj < -FIL_INTERP_TOL;
       if (!bi && !bj) continue;
-      fesd__violation v = {1, tn + tau * h, bi ? i : j, k, 0, n, n * s + s, 0, bi && bj ? -1 : 1, 0, 0};
+      fesd__violation v = {1, tn + tau * h, bi ? i : j, k, 0, n, n * s + s, 0, bi && bj ? -1 : 1, 0, 0, 0};
       fesd__note_violation(&ps[k], &v);
       break;
     }
@@ -368,7 +368,7 @@ static int scan_filippov(fesd_integrator *it, const double *z, const unsigned ch
           fesd__sliding_margins(it, &pe, th, it->ftot, i, j, it->fil_mi + k * s + q, it->fil_mj + k * s + q);
           int c = fesd__filippov(it, &pe, th, it->ftot, i, j, FIL_STAGE_TOL);
           if (c == -2 || !fesd__alternative_exists(it, &pe, a, k, i, j)) continue;
-          fesd__violation v = {1, tn + S->tab.c[q] * h, c < 0 ? i : c, k, 0, n, n * s + q, 0, 1, 0, 0};
+          fesd__violation v = {1, tn + S->tab.c[q] * h, c < 0 ? i : c, k, 0, n, n * s + q, 0, 1, 0, 0, 0};
           v.filippov = c < 0 ? -1 : 1;
           fesd__note_violation(&ps[k], &v);
         }

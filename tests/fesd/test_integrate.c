@@ -183,7 +183,9 @@ int main(void) {
         for (int i = 0; i < P.model.nx; i++) err = fmax(err, fabs(x[i] - xe[i]) / fmax(1.0, fabs(xe[i])));
         FESD_TEST_CHECK(st == FESD_OK && err <= 100 * tol, "%s %s tol %.0e: %s, error %.2e", probs[p],
                         fesd_rk_family_name(fams[f]), tol, fesd_status_name(st), err);
-        FESD_TEST_CHECK(err <= 2 * prev || err <= 1e-13, "%s %s tol %.0e: error %.2e grew from %.2e", probs[p],
+        /* the error follows the tolerance down; far below it (1e-3 tol: set by the exact events,
+         * slide-exit-2d at 1e-3 / 1e-4: 2.8e-8 / 5.7e-8) it may not */
+        FESD_TEST_CHECK(err <= 2 * prev || err <= 1e-13 || err <= 1e-3 * tol, "%s %s tol %.0e: error %.2e grew from %.2e", probs[p],
                         fesd_rk_family_name(fams[f]), tol, err, prev);
         prev = err;
         worst_ratio = fmax(worst_ratio, err / tol);

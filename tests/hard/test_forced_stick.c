@@ -192,6 +192,58 @@ static int stops_at_exits(fso *p, const fesd_model *m0, double x0, double T, con
   return bad;
 }
 
+/* The review's case (24) one step per call (fesd_integrate_step) and in one call: the same
+ * steps, bit for bit, and the reference's events. The margins' history behind the step caps of
+ * a stuck phase (graze.c) was cleared on every call: stepped one step per call (or through
+ * fesd_integrate_grid), Radau IIA s = 3 at rtol 1e-6 and Gauss-Legendre s = 2 at 1e-8 stepped
+ * over the slip (x(30) 13 and 1.3e3 tolerances off, FESD_OK). Returns the number of bad runs. */
+static int step_by_step(const fesd_model *m, const fso *p, double x0, double T, const ev_list *E, int *runs) {
+  static const int meth[][2] = {{FESD_RK_RADAU_IIA, 2}, {FESD_RK_RADAU_IIA, 3}, {FESD_RK_GAUSS_LEGENDRE, 2},
+                                {FESD_RK_GAUSS_LEGENDRE, 3}, {FESD_RK_LOBATTO_IIIC, 3}};
+  int bad = 0;
+  for (unsigned mi = 0; mi < sizeof meth / sizeof *meth; mi++)
+    for (int r = 0; r < 3; r++) {
+      double xe[2][2];
+      int ne[2], st[2], ok[2];
+      for (int one = 0; one < 2; one++) {
+        fesd_settings set;
+        fesd_settings_default(&set);
+        set.family = (fesd_rk_family)meth[mi][0], set.stages = meth[mi][1];
+        fesd_integrator *it;
+        st[one] = fesd_create(&it, m, &set);
+        if (st[one]) continue;
+        fesd_tolerances tol;
+        fesd_tolerances_default(&tol);
+        tol.rtol = r == 0 ? 1e-6 : r == 1 ? 1e-8 : 1e-9;
+        tol.atol = 1e-2 * tol.rtol;
+        double x[2] = {x0, p->vb};
+        fesd_set_tolerances(it, &tol);
+        fesd_set_state(it, 0.0, x, NULL);
+        fesd_integrate_info info;
+        if (one) {
+          do st[one] = fesd_integrate_step(it, NULL, T, &info);
+          while (st[one] == FESD_OK && info.t < T);
+        } else {
+          st[one] = fesd_integrate(it, NULL, T, &info);
+        }
+        fesd_get_state(it, NULL, xe[one]);
+        const fesd_event *ev;
+        fesd_event_log(it, &ev, &ne[one]);
+        ok[one] = st[one] == FESD_OK && same_events(ev, ne[one], E, r == 0 ? 1e-4 : 1e-6);
+        fesd_free(&it);
+      }
+      (*runs)++;
+      if (!ok[0] || !ok[1] || xe[0][0] != xe[1][0] || xe[0][1] != xe[1][1]) {
+        bad++;
+        printf("  case 24 %s s=%d rtol %.0e: one call %s (%d events%s), step by step %s (%d events%s), x(T) %s\n",
+               fesd_rk_family_name((fesd_rk_family)meth[mi][0]), meth[mi][1], r == 0 ? 1e-6 : r == 1 ? 1e-8 : 1e-9,
+               fesd_status_name(st[0]), ne[0], ok[0] ? "" : ", not the reference's", fesd_status_name(st[1]), ne[1],
+               ok[1] ? "" : ", not the reference's", xe[0][0] == xe[1][0] && xe[0][1] == xe[1][1] ? "equal" : "differ");
+      }
+    }
+  return bad;
+}
+
 static double unif(unsigned long long *s) {
   *s = *s * 6364136223846793005ULL + 1442695040888963407ULL;
   return (double)(*s >> 11) * 0x1.0p-53;
@@ -212,7 +264,7 @@ int main(void) {
   const int n_modes[1] = {2}, n_switch[1] = {1};
   unsigned long long seed = 20261128ULL;
   int runs = 0, right = 0, wrong_ev = 0, wrong_x = 0, failed = 0, events = 0, flagged_wrong = 0, short_sticks = 0;
-  int stop_runs = 0, stop_bad = 0;
+  int stop_runs = 0, stop_bad = 0, sbs_runs = 0, sbs_bad = 0;
   double worst = 0;
   for (int c = 0; c < 25; c++) {
     fso p;
@@ -237,6 +289,7 @@ int main(void) {
     m.nx = 2, m.nsys = 1, m.n_modes = n_modes, m.n_switch = n_switch, m.field = field, m.sw = sw, m.user = &p;
     m.time_dependent = 1;
     stop_bad += stops_at_exits(&p, &m, x0, T, &E, &stop_runs);
+    if (c == 24) sbs_bad += step_by_step(&m, &p, x0, T, &E, &sbs_runs);
     for (unsigned mi = 0; mi < sizeof meth / sizeof *meth; mi++)
       for (int r = 0; r < 2; r++) {
         fesd_settings set;
@@ -311,6 +364,9 @@ int main(void) {
   printf("stop conditions at a sliding exit (Radau s = 2, 5, Lobatto IIIC s = 3, rtol 1e-6): %d runs, %d with other "
          "events or failed\n", stop_runs, stop_bad);
   HD_CHECK(stop_bad == 0, "%d of %d stop runs wrong", stop_bad, stop_runs);
+  printf("the review's case one step per call and in one call (Radau s = 2, 3, Gauss s = 2, 3, Lobatto IIIC s = 3, "
+         "rtol 1e-6, 1e-8, 1e-9): %d runs, %d wrong or not the same\n", sbs_runs, sbs_bad);
+  HD_CHECK(sbs_bad == 0, "%d of %d step-by-step runs wrong", sbs_bad, sbs_runs);
   printf("%d failures\n", fails);
   return fails != 0;
 }
