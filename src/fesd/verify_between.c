@@ -367,7 +367,7 @@ static void scan_excursions(fesd_integrator *it, const double *z, const unsigned
     const double tv = 0.5 * (t[q - 1] + t[q]) - 0.5 * d1 / c2; /* the vertex */
     if (!(v[q] * S->wG[k] > -tol)) {
       /* below the surface at a check point (the sign checks' entry): where it turns back */
-      if (ps[k].found && ps[k].enter && ps[k].element == n && ps[k].t <= tn + tv * h) ps[k].back = tn + tv * h;
+      if (ps[k].found && ps[k].enter && ps[k].element == n && ps[k].t <= tn + t[q + 1] * h) ps[k].back = tn + tv * h;
       continue;
     }
     double pv = parabola_at(t, v, q, tv);

@@ -28,7 +28,7 @@ typedef struct {
   int ev_sys[4096], ev_kind[4096];
 } chain_run;
 
-static int run_chain(int n, double T, fesd_rk_family fam, int s, double h, chain_run *r) {
+static int run_chain(int n, double T, fesd_rk_family fam, int s, double h, const double *x0, chain_run *r) {
   fesd_friction_chain fc;
   if (n > NMAX || fesd_friction_chain_stick_slip(&fc, n)) return -1;
   fesd_settings set;
@@ -37,7 +37,7 @@ static int run_chain(int n, double T, fesd_rk_family fam, int s, double h, chain
   set.stages = s;
   fesd_integrator *it;
   int st = fesd_create(&it, &fc.model, &set);
-  if (!st) st = fesd_set_state(it, 0.0, fc.x0, NULL);
+  if (!st) st = fesd_set_state(it, 0.0, x0 ? x0 : fc.x0, NULL);
   const int K = (int)lround(T / h);
   r->n_ev = r->steps_done = r->worst_iter = r->iters_sw = r->splits = 0;
   for (int k = 0; k < K && !st; k++) {
@@ -64,8 +64,9 @@ static int run_chain(int n, double T, fesd_rk_family fam, int s, double h, chain
 }
 
 /* The same chain error-controlled (fesd_integrate, Radau IIA s, rtol, atol = 1e-3 rtol): the
- * events of the log; iters_sw: all Newton iterations, steps_done: accepted steps. */
-static int run_chain_tol(int n, double T, int s, double rtol, chain_run *r) {
+ * events of the log; iters_sw: all Newton iterations, steps_done: accepted steps. x0: NULL for
+ * the chain's own start. */
+static int run_chain_tol(int n, double T, int s, double rtol, const double *x0, chain_run *r) {
   fesd_friction_chain fc;
   if (n > NMAX || fesd_friction_chain_stick_slip(&fc, n)) return -1;
   fesd_settings set;
@@ -78,7 +79,7 @@ static int run_chain_tol(int n, double T, int s, double rtol, chain_run *r) {
   tol.rtol = rtol;
   tol.atol = 1e-3 * rtol;
   if (!st) st = fesd_set_tolerances(it, &tol);
-  if (!st) st = fesd_set_state(it, 0.0, fc.x0, NULL);
+  if (!st) st = fesd_set_state(it, 0.0, x0 ? x0 : fc.x0, NULL);
   fesd_integrate_info info = {0};
   if (!st) st = fesd_integrate(it, NULL, T, &info);
   const fesd_event *ev;
@@ -107,6 +108,49 @@ static int same_events(const chain_run *a, const chain_run *b) {
   return 1;
 }
 
+/* ---- random starts under error control: near-tangential sticks ---- */
+static double unif(unsigned long long *q) {
+  *q = *q * 6364136223846793005ULL + 1442695040888963407ULL;
+  return (double)(*q >> 11) * 0x1.0p-53;
+}
+
+/* 4-mass chains from random starts (q_i in [-1, 1], v_i the belt's or random in [-1, 1]; seed of
+ * a review), T = 10, Radau IIA s = 3, 5 at rtol 1e-7 against Lobatto IIIC s = 4 at h = 0.2/64:
+ * the reference's events and x(T) within 100 tolerances. One case arrives at the belt speed
+ * nearly tangentially and sticks for 0.0116 inside an element of 0.44 (the slip trajectory
+ * crosses the belt speed by 1.5e-5 and turns back): at 8507b4e Radau s = 5 stepped over it, 9
+ * events of 11, x(10) 131 tolerances off, FESD_OK. Returns the failures. */
+static int random_chains(void) {
+  int fails = 0, runs = 0, bad = 0;
+  const int n = 4, S[2] = {3, 5};
+  unsigned long long seed = 21;
+  static chain_run R, A;
+  for (int c = 0; c < 8; c++) {
+    double x0[8];
+    for (int i = 0; i < n; i++) {
+      x0[i] = 2 * unif(&seed) - 1;
+      const double u = unif(&seed);
+      x0[n + i] = u < 0.5 ? 0.2 : 2 * unif(&seed) - 1; /* 0.2: the stick-slip chain's belt */
+    }
+    HD_CHECK(run_chain(n, 10, FESD_RK_LOBATTO_IIIC, 4, 0.2 / 64, x0, &R) == FESD_OK, "case %d reference: %s", c,
+             fesd_status_name(R.st));
+    for (int q = 0; q < 2; q++) {
+      const int st = run_chain_tol(n, 10, S[q], 1e-7, x0, &A);
+      double e = 0;
+      for (int i = 0; i < 2 * n; i++) e = fmax(e, fabs(A.x[i] - R.x[i]) / (1e-7 * (1 + fabs(R.x[i]))));
+      runs++;
+      if (st != FESD_OK || !same_events(&A, &R) || !(e < 100)) {
+        bad++;
+        printf("  random chain case %d s=%d: %s, %d events (reference %d), x(10) %.3g tolerances off\n", c, S[q],
+               fesd_status_name(st), A.n_ev, R.n_ev, e);
+      }
+    }
+  }
+  printf("random 4-mass chains, rtol 1e-7, Radau IIA s = 3, 5: %d runs, %d wrong or failed\n", runs, bad);
+  HD_CHECK(bad == 0, "%d of %d random chain runs wrong or failed", bad, runs);
+  return fails;
+}
+
 /* ---- two decoupled relays ---- */
 static int relay_field(int sys, int mode, double t, const double *x, const double *u, double *f, void *user) {
   f[0] = f[1] = 0;
@@ -126,9 +170,9 @@ int main(void) {
   for (int c = 0; c < 2; c++) {
     const int n = ns[c], nx = 2 * n;
     const double T = Ts[c];
-    HD_CHECK(run_chain(n, T, FESD_RK_LOBATTO_IIIC, 4, 0.2 / 32, &R) == FESD_OK, "n=%d reference: %s at step %d", n,
+    HD_CHECK(run_chain(n, T, FESD_RK_LOBATTO_IIIC, 4, 0.2 / 32, NULL, &R) == FESD_OK, "n=%d reference: %s at step %d", n,
              fesd_status_name(R.st), R.steps_done);
-    HD_CHECK(run_chain(n, T, FESD_RK_RADAU_IIA, 4, 0.2 / 32, &R4) == FESD_OK, "n=%d Radau s=4 check: %s", n,
+    HD_CHECK(run_chain(n, T, FESD_RK_RADAU_IIA, 4, 0.2 / 32, NULL, &R4) == FESD_OK, "n=%d Radau s=4 check: %s", n,
              fesd_status_name(R4.st));
     printf("chain n=%d T=%g: reference Lobatto IIIC s=4 h=0.00625: %d events; Radau IIA s=4 at the same h differs "
            "by %.1e, events %s\n", n, T, R.n_ev, hd_maxdiff(R.x, R4.x, nx), same_events(&R, &R4) ? "same" : "DIFFER");
@@ -136,7 +180,7 @@ int main(void) {
       double e_fit[3], h_fit[3];
       int nfit = 0;
       for (int g = 0; g < 3; g++) {
-        int st = run_chain(n, T, FESD_RK_RADAU_IIA, s, hs[g], &A);
+        int st = run_chain(n, T, FESD_RK_RADAU_IIA, s, hs[g], NULL, &A);
         HD_CHECK(st == FESD_OK, "n=%d s=%d h=%g: %s at step %d", n, s, hs[g], fesd_status_name(st), A.steps_done);
         if (st) continue;
         const double err = hd_maxdiff(A.x, R.x, nx), per_ev = A.n_ev ? (double)A.iters_sw / A.n_ev : 0;
@@ -159,7 +203,7 @@ int main(void) {
      * 242 iterations for 94 events, 2.2) */
     const double rtols[2] = {1e-3, 1e-6};
     for (int q = 0; q < 2; q++) {
-      int st = run_chain_tol(n, T, 3, rtols[q], &A);
+      int st = run_chain_tol(n, T, 3, rtols[q], NULL, &A);
       HD_CHECK(st == FESD_OK, "n=%d rtol=%g: %s", n, rtols[q], fesd_status_name(st));
       if (st) continue;
       double xmax = 0;
@@ -177,9 +221,9 @@ int main(void) {
   }
   for (int c = 0; c < 2; c++) {
     const int n = c ? 256 : 128;
-    HD_CHECK(run_chain(n, 4.0, FESD_RK_RADAU_IIA, 2, 0.05, &R) == FESD_OK, "n=%d h=0.05: %s at step %d", n,
+    HD_CHECK(run_chain(n, 4.0, FESD_RK_RADAU_IIA, 2, 0.05, NULL, &R) == FESD_OK, "n=%d h=0.05: %s at step %d", n,
              fesd_status_name(R.st), R.steps_done);
-    const int st = run_chain(n, 4.0, FESD_RK_RADAU_IIA, 2, 0.2, &A);
+    const int st = run_chain(n, 4.0, FESD_RK_RADAU_IIA, 2, 0.2, NULL, &A);
     HD_CHECK(st == FESD_OK, "n=%d h=0.2: %s at step %d", n, fesd_status_name(st), A.steps_done);
     if (st) continue;
     const double per_ev = A.n_ev ? (double)A.iters_sw / A.n_ev : 0, worst_per_ev = (double)A.worst_iter / (A.worst_ev + 1);
@@ -210,6 +254,7 @@ int main(void) {
     printf("two decoupled relays crossing inside one step: err %.1e, %d Newton iterations\n", err, info.newton_iter);
     fesd_free(&it);
   }
+  fails += random_chains();
   printf("%d failures\n", fails);
   return fails != 0;
 }
