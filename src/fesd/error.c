@@ -143,10 +143,10 @@ int fesd__error_estimate(fesd_integrator *it, const double *z, double rtol, cons
  * component (p = 2: all up; p = 3: alternating), from a fresh evaluation unless `fresh` is 0
  * (the point and ftot of the previous call); *speed: the weighted norm of the field there (the
  * state error per unit of time error, in the norm of fesd__error_estimate). */
-static int margins_at(fesd_integrator *it, const double *z, int kb, double tb, int p, int fresh, int i, int j,
-                      double rtol, const double *atol, double *mi, double *mj, double *speed) {
+static int margins_at(fesd_integrator *it, const double *z, const unsigned char *a, int kb, double tb, int p,
+                      int fresh, int i, int j, double rtol, const double *atol, double *mi, double *mj,
+                      double *speed) {
   fesd__system *S = &it->sys;
-  const unsigned char *a = it->act + (size_t)((kb - 1) * S->s + S->s - 1) * S->nth;
   const double *x = p != 1 ? z + S->xo[kb - 1] : kb == 1 ? S->x0 : z + S->xo[kb - 2];
   if (p >= 2) { /* the end point moved by its tolerance, +sc (p = 2) or alternating signs */
     double *xp = it->gbuf + S->nth;
@@ -193,12 +193,12 @@ static int margins_at(fesd_integrator *it, const double *z, int kb, double tb, i
 /* What the state's own tolerance makes of the staying mode's margin m0 at the end of element
  * kb - 1: its largest change when the end point moves by the tolerance of each component (two
  * directions). A margin within it is as exact as the state. */
-static int margin_noise(fesd_integrator *it, const double *z, int kb, double tb, int i, int j, int stay_i, double m0,
-                        double rtol, const double *atol, double *noise) {
+static int margin_noise(fesd_integrator *it, const double *z, const unsigned char *a, int kb, double tb, int i, int j,
+                        int stay_i, double m0, double rtol, const double *atol, double *noise) {
   *noise = 0;
   for (int p = 2; p <= 3; p++) {
     double mi, mj, v;
-    int st = margins_at(it, z, kb, tb, p, 1, i, j, rtol, atol, &mi, &mj, &v);
+    int st = margins_at(it, z, a, kb, tb, p, 1, i, j, rtol, atol, &mi, &mj, &v);
     if (st) return st;
     *noise = fesd__fmax(*noise, fabs((stay_i ? mi : mj) - m0));
   }
@@ -213,8 +213,24 @@ int fesd__exit_error(fesd_integrator *it, const double *z, double rtol, const do
   for (int kb = 1; kb <= S->N; kb++) {
     tb += z[S->ho[kb - 1]];
     const int end = kb == S->N;
-    if (!end && it->bmode[kb] != 2) continue;
     const unsigned char *a = it->act + (size_t)((kb - 1) * S->s + S->s - 1) * S->nth;
+    /* the leaving mode of an exit at boundary kb: pinned (bmode 2), or an unpinned one of the
+     * fallback path (a mode of a 2-mode set not active after the boundary; Gauss-Legendre off
+     * the plan path: an exit 0.048 late, x(30) 6e6 tolerances off at rtol 1e-10, found by a
+     * review) */
+    int leave = -1;
+    if (!end && it->bmode[kb] == 2) leave = it->exit_mode[kb];
+    else if (!end && !it->exit_pinned)
+      for (int k = 0; k < m->nsys && leave < 0; k++) {
+        int j, i = fesd__two_modes(m, a, k, &j);
+        if (i >= 0 && !a[S->nth + i]) leave = i;
+        else if (i >= 0 && !a[S->nth + j]) leave = j;
+      }
+    if (!end && leave < 0) continue;
+    /* the fallback path can leave a sliding mode between the stages of the last element (its
+     * exit is logged at the step end): the margins of the set it slid on */
+    if (end && !it->exit_pinned && fesd__count_two_modes(m, a) == 0)
+      a = it->act + (size_t)((kb - 1) * S->s) * S->nth;
     /* with two or more sliding subsystems their multipliers are coupled (a co-dimension-2
      * sliding mode): one subsystem's 2-mode margin with the others' held is not its own
      * (measured: the check on such margins took 66136 steps instead of 984, prop_integrate) */
@@ -222,17 +238,17 @@ int fesd__exit_error(fesd_integrator *it, const double *z, double rtol, const do
     int fresh = 1;
     for (int k = 0; k < m->nsys; k++) {
       int j, i = fesd__two_modes(m, a, k, &j);
-      if (i < 0 || (!end && m->sys_of[it->exit_mode[kb]] != k)) continue;
+      if (i < 0 || (!end && m->sys_of[leave] != k)) continue;
       double mi, mj, m0, m1, speed, v;
-      int st = margins_at(it, z, kb, tb, 0, fresh, i, j, rtol, atol, &mi, &mj, &speed);
+      int st = margins_at(it, z, a, kb, tb, 0, fresh, i, j, rtol, atol, &mi, &mj, &speed);
       if (st) return st;
       fresh = 0;
       /* the staying mode: the one left at a pinned exit; at the step end the one whose margin
        * went negative (none: the mode still slides) */
-      const int stay_i = end ? mi < mj : it->exit_mode[kb] != i;
+      const int stay_i = end ? mi < mj : leave != i;
       m0 = stay_i ? mi : mj;
       if (end && !(m0 < 0)) continue;
-      if ((st = margins_at(it, z, kb, tb, 1, 1, i, j, rtol, atol, &mi, &mj, &v))) return st;
+      if ((st = margins_at(it, z, a, kb, tb, 1, 1, i, j, rtol, atol, &mi, &mj, &v))) return st;
       m1 = stay_i ? mi : mj;
       fresh = 1; /* the end point's evaluation was replaced */
       /* the margin falls to its zero at the exit: a linear fit through both points */
@@ -244,7 +260,7 @@ int fesd__exit_error(fesd_integrator *it, const double *z, double rtol, const do
        * sliding element of 2.9e-7, which shorter steps did not change, until
        * FESD_ERR_STEP_TOO_SMALL. */
       double noise;
-      if ((st = margin_noise(it, z, kb, tb, i, j, stay_i, m0, rtol, atol, &noise))) return st;
+      if ((st = margin_noise(it, z, a, kb, tb, i, j, stay_i, m0, rtol, atol, &noise))) return st;
       const double dt = fesd__fmax(fabs(m0) - noise, 0.0) / -rate;
       /* A pinned exit off by more than its sliding element is long: a shorter step does not
        * move it (Gauss-Legendre's multipliers are not damped, |R(inf)| = 1, and carry an error
@@ -278,10 +294,11 @@ int fesd__still_slides(fesd_integrator *it, const double *z, int i, int j, int l
   const int stay_i = leave != i;
   double mi, mj, v, noise = 0;
   *slides = 0;
-  int st = margins_at(it, z, S->N, tb, 0, 1, i, j, rtol, atol, &mi, &mj, &v);
+  const unsigned char *a = it->act + (size_t)(S->N * S->s - 1) * S->nth;
+  int st = margins_at(it, z, a, S->N, tb, 0, 1, i, j, rtol, atol, &mi, &mj, &v);
   if (st) return st;
   const double m0 = stay_i ? mi : mj;
-  if (m0 > 0 && (st = margin_noise(it, z, S->N, tb, i, j, stay_i, m0, rtol, atol, &noise))) return st;
+  if (m0 > 0 && (st = margin_noise(it, z, a, S->N, tb, i, j, stay_i, m0, rtol, atol, &noise))) return st;
   *slides = m0 > noise;
   return FESD_OK;
 }

@@ -319,9 +319,6 @@ static void rollback(fesd_integrator *it) {
  * rtol 1e-3: 16 steps, one of 0.59 with 154 switches and 466 Newton iterations, 702 in all,
  * 8.1 s; limited: 46 steps, 364 iterations, 3.8 s; rtol 1e-6: 4.6 -> 3.4 s). At most a
  * fivefold cut, so that a burst of simultaneous switches costs a few steps, not a collapse. */
-/* retries of a step whose exit was not pinned (below) */
-#define MAX_UNPINNED 4
-
 static double switch_limit(const fesd_integrator *it, double hh, int E) {
   const int cap = it->set.max_elements - 2 > 1 ? it->set.max_elements - 2 : 1;
   return E > cap ? hh * fmax(0.2, (double)cap / E) : INFINITY;
@@ -346,7 +343,7 @@ static int integrate(fesd_integrator *it, const double *u, double t_out, fesd_in
   const double span = t_out - it->t, hmax = it->tol.h_max > 0 ? it->tol.h_max : INFINITY;
   double h = it->h_next > 0 ? it->h_next : it->tol.h_init > 0 ? it->tol.h_init : first_step(it, u, span);
   const double hmin = it->tol.h_min > 0 ? it->tol.h_min : 1e-14 * fmax(fabs(it->t), fabs(t_out));
-  int st = FESD_OK, graze_retry = 0, unpinned = 0;
+  int st = FESD_OK, graze_retry = 0;
   /* the graze check's values at the start: again on every call (u or the callbacks' data may
    * have changed since the last one at this time) */
   it->ap_t = NAN;
@@ -392,19 +389,6 @@ static int integrate(fesd_integrator *it, const double *u, double t_out, fesd_in
     }
     const double err = si.error_estimate;
     const double fac = err > 0 ? 0.9 * pow(err, -1.0 / it->err_q) : 5.0;
-    /* an exit the family pins, taken by the fallback path that does not (Gauss-Legendre: its
-     * element end's multiplier, exit_ext): a shorter step, a few times, before it is accepted
-     * flagged. Measured (a review; forced stick-slip, Gauss s = 3, rtol 1e-10): a step of 0.67
-     * whose plan failed at the exit took it at its end, 0.048 late, x(30) 6e6 tolerances off */
-    if ((si.flags & FESD_FLAG_EXIT_NOT_PINNED) && it->set.exit_rows && !it->tab.is_explicit &&
-        unpinned < MAX_UNPINNED && 0.5 * hh >= hmin) {
-      rollback(it);
-      info->rejected++;
-      h = 0.5 * hh;
-      it->ec_rejected = 1;
-      unpinned++;
-      continue;
-    }
     if (!(err <= 1.0)) { /* error test failed */
       rollback(it);
       info->rejected++;
@@ -480,7 +464,6 @@ static int integrate(fesd_integrator *it, const double *u, double t_out, fesd_in
     h = fmax(fmin(h, cap), hmin);
     it->ec_err_prev = fmax(err, 1e-4);
     it->ec_rejected = 0;
-    unpinned = 0;
     if (one_step) break;
   }
   it->ec_on = 0;
