@@ -53,7 +53,7 @@ typedef struct {
   double lo, hi; /* bracket of the switch: the last point seen on the right side, the point
                     where the sign was violated (the trajectory agrees up to the switch) */
   double back;    /* an excursion between check points (verify_between.c): the time the
-                     trajectory turns back (NaN or 0: none) */
+                     trajectory turns back (0: none) */
 } fesd__violation;
 
 /* A saved state (integrator.c): the step start, restored when fesd_step fails, and the start

@@ -315,7 +315,8 @@ static double parabola_at(const double *t, const double *v, int q, double x) {
  * slip trajectory crosses the belt speed by 1.5e-5 and returns): stepped over, 9 events of 11,
  * x(10) 131 tolerances off, FESD_OK. The parabolas through the smallest value and the points
  * two before or after it must dip too, so that the interpolation's own error is not taken for
- * an excursion. gm: the indicators at the midpoints. */
+ * an excursion. gm: per midpoint and subsystem, the least other mode's indicator minus the
+ * active one's (scan_interior). */
 static void scan_excursions(fesd_integrator *it, const double *z, const unsigned char *act, int n, double tn,
                             double h, const double *gm, fesd__violation *ps) {
   const fesd__system *S = &it->sys;
@@ -394,7 +395,7 @@ int fesd__scan_interior(fesd_integrator *it, const double *z, const unsigned cha
   fesd__system *S = &it->sys;
   fesd__model *m = &it->model;
   const int s = S->s, nth = S->nth;
-  double *xm = it->gbuf + nth; /* the midpoint states of an element, then the gaps (below) */
+  double *xm = it->gbuf + nth; /* the midpoint states of an element, then their gaps (gm) */
   double *gm = xm + (size_t)(FESD_RK_MAX_STAGES + 1) * S->nx;
   fesd__point_eval pe = fesd__scratch_eval(it);
   double tn = 0;
