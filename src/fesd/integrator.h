@@ -237,9 +237,17 @@ double fesd__hermite_first_zero(double a, double b, double da, double db, double
 /* Graze check of an error-controlled step (graze.c). */
 int fesd__graze_rates(fesd_integrator *it, const double *u, double *lam, double *rate, double *margin);
 double fesd__slide_cap(const fesd_integrator *it, double hh, const double *m_a, const double *m_b);
-/* A stop condition that crossed back against its last stop's direction in the last step is armed
- * again (integrate.c; also after steps of plain fesd_step between integration calls). */
+/* The event log and stop conditions of error-controlled integration (event_log.c). A stop
+ * condition that crossed back against its last stop's direction in the last step is armed
+ * again (also after steps of plain fesd_step between integration calls). */
 void fesd__rearm_stops(fesd_integrator *it);
+/* The last step's events appended to the log (stopping: a stop ends the step, stop_up: its
+ * direction; its own crossing is logged by fesd__take_stop). */
+int fesd__log_events(fesd_integrator *it, int stopping, int stop_up);
+/* The integration stops on condition k at the current time: FESD_ROOT (or the log's failure). */
+int fesd__take_stop(fesd_integrator *it, int k, int dir, fesd_integrate_info *info);
+/* The earliest stop condition the last step crossed after t_from in its direction, -1: none. */
+int fesd__root_crossed(const fesd_integrator *it, double t_from, double *t_root, int *dir);
 double fesd__graze_dip(const fesd_integrator *it, double hh, const double *lam_a, const double *rate_a,
                        const double *lam_b, const double *rate_b);
 /* Whether the method has a collocation polynomial (dense output, interior checks). */
