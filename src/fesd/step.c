@@ -424,6 +424,7 @@ static int try_step(fesd_integrator *it, const double *u, double *T, fesd_step_i
   if ((st = fesd__act_start(it, u, it->act0, &nonunique))) return st;
   it->start_jumped = 0;
   it->nonunique = nonunique;
+  it->exc_found = 0;
   st = it->set.method == FESD_METHOD_FESD ? plan_path(it, T, info) : fesd__std_path(it, info);
   if (fesd__hard_failure(st)) return st;
   if (st != FESD_OK && it->set.method == FESD_METHOD_FESD) {
@@ -476,6 +477,19 @@ static int try_step(fesd_integrator *it, const double *u, double *T, fesd_step_i
   return st;
 }
 
+/* The last resort of a fixed step (below) whose attempts failed after an excursion between check
+ * points: the excursion check off, the step flagged. The discrete solution dips below the surface
+ * by its own error where the flow only comes close (a near miss of 1e-10 after a crossing, Radau
+ * IIA s = 2, h = 0.15: a dip of 1e-4), and the entry planned there has no solution (found by a
+ * review: FESD_ERR_STEP_FAILED in 11 of 7200 such runs). Error control takes shorter steps. */
+static int try_without_excursions(fesd_integrator *it, const double *u, double *T, fesd_step_info *info) {
+  it->exc_off = 1;
+  int st = try_step(it, u, T, info);
+  it->exc_off = 0;
+  if (st == FESD_OK) it->step_flags |= FESD_FLAG_AMBIGUOUS;
+  return st;
+}
+
 int fesd__substep(fesd_integrator *it, const double *u, double T, int depth, fesd_step_info *info) {
   double done = 0, prev = 0;
   while (done < T) {
@@ -484,7 +498,14 @@ int fesd__substep(fesd_integrator *it, const double *u, double T, int depth, fes
     if (prev > 0 && Ts > lim + 0.5 * prev) Ts = lim;
     fesd__save(it, &it->bk_sub);
     const int fb = info->fallback;
+    const double Ts0 = Ts;
     int st = try_step(it, u, &Ts, info);
+    if (st != FESD_OK && !fesd__hard_failure(st) && depth >= it->set.max_splits && !it->ec_on && it->exc_found) {
+      info->fallback = fb;
+      fesd__load(it, &it->bk_sub);
+      Ts = Ts0;
+      st = try_without_excursions(it, u, &Ts, info);
+    }
     if (Ts < info->min_substep) info->min_substep = Ts;
     if (st == FESD_OK) {
       info->last_time = it->t;

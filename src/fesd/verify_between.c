@@ -324,6 +324,7 @@ static void scan_excursions(fesd_integrator *it, const double *z, const unsigned
   const int s = S->s, nth = S->nth, np = it->n_exc;
   const unsigned char *a = act + (size_t)(n * s) * nth;
   const double tol = INTERIOR_TOL * it->set.cc_tol, *t = it->exc_tau;
+  if (it->exc_off) return;
   for (int k = 0; k < m->nsys; k++) {
     const int ja = fesd__one_mode(m, a, k), i0 = m->th_off[k], i1 = m->th_off[k + 1];
     if (ja < 0) continue;
@@ -386,6 +387,7 @@ static void scan_excursions(fesd_integrator *it, const double *z, const unsigned
     const double tz = fmax(t[q - 1], tv - sqrt(-pv / c2)); /* its first zero */
     fesd__violation c = {1, tn + tz * h, mode, k, 1, n, n * s + s, 0, 0, tn + t[q - 1] * h, tn + tv * h, tn + tv * h};
     fesd__note_violation(&ps[k], &c);
+    it->exc_found = 1;
   }
 }
 
