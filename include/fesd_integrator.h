@@ -229,7 +229,10 @@ typedef struct {
                                      Zeno accumulation); or the step's events hold two switches of
                                      one subsystem less than 1e-9 max(1, |t|) apart (a phase of
                                      zero length, e.g. exit, re-entry, exit at one instant): their
-                                     order is not resolved */
+                                     order is not resolved; or (fixed steps) the discrete solution
+                                     dipped into another mode's region between check points where
+                                     no entry could be solved, and the step was taken without that
+                                     dip (the flow may only come close to the surface there) */
 
 /** Statistics of one fesd_step() (accumulated over sub-steps when it splits). */
 typedef struct {
