@@ -286,15 +286,12 @@ int fesd__exit_error(fesd_integrator *it, const double *z, double rtol, const do
 
 int fesd__still_slides(fesd_integrator *it, const double *z, int i, int j, int leave, int *slides) {
   fesd__system *S = &it->sys;
-  if (fesd__count_two_modes(&it->model, it->act + (size_t)(S->N * S->s - 1) * S->nth) != 1) {
-    *slides = 0; /* as fesd__exit_error */
-    return FESD_OK;
-  }
+  const unsigned char *a = it->act + (size_t)(S->N * S->s - 1) * S->nth;
+  *slides = 0;
+  if (fesd__count_two_modes(&it->model, a) != 1) return FESD_OK; /* as fesd__exit_error */
   const double tb = S->t0 + S->T, rtol = it->tol.rtol, *atol = it->tol_atol;
   const int stay_i = leave != i;
   double mi, mj, v, noise = 0;
-  *slides = 0;
-  const unsigned char *a = it->act + (size_t)(S->N * S->s - 1) * S->nth;
   int st = margins_at(it, z, a, S->N, tb, 0, 1, i, j, rtol, atol, &mi, &mj, &v);
   if (st) return st;
   const double m0 = stay_i ? mi : mj;

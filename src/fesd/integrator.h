@@ -174,10 +174,10 @@ struct fesd_integrator {
   double mid_w[(FESD_RK_MAX_STAGES + 1) * FESD_RK_MAX_STAGES];
   double mid_tau[FESD_RK_MAX_STAGES + 1];
   int mid_stage[FESD_RK_MAX_STAGES + 1]; /* the stage nearest to each midpoint */
+  int exc_off, exc_found; /* the excursion check switched off, and whether it found one (step.c) */
   /* the excursion check's nodes in time order: 0 (the element start), the stages (c_j > 0: at
    * exc_stage[j] >= 1, else -1) and the midpoints (at exc_mid[p]); exc_tau their times */
-  int exc_off, exc_found; /* the excursion check switched off, and whether it found one (step.c) */
-  int n_exc, exc_stage[FESD_RK_MAX_STAGES], exc_mid[FESD_RK_MAX_STAGES + 1]; /* positions in: */
+  int n_exc, exc_stage[FESD_RK_MAX_STAGES], exc_mid[FESD_RK_MAX_STAGES + 1];
   double exc_tau[2 * FESD_RK_MAX_STAGES + 2];
   /* error estimate (error.c): embedded weights (e0 on the field at the element start, e_j on
    * the stages), order of the estimate */
